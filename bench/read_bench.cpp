@@ -1,0 +1,152 @@
+// Reader throughput: each reader vs a raw read() of the same bytes, measured in the same run
+// with the page cache warm, so the ratio shows parsing cost rather than disk speed.
+//
+// usage: read_bench FILE [--keep-temp]
+// FILE is read as it is; then the same points are written as binary big-endian PLY, ascii PLY,
+// LAS 1.4 (point format 7) and XYZ text in a temporary folder and each is measured too.
+// One line per reader and phase:
+//   bench=read reader=ply_binary_little_endian phase=parse points=... mpoints_per_s=...
+//   mb_per_s=... raw_mb_per_s=... ratio_vs_raw=...
+// phase=open_and_read includes the bounds pre-pass of formats whose header has no bounds;
+// phase=parse passes the bounds in (OpenOptions::knownBounds), so it is the streaming parse.
+#include "las_writer.hpp"
+#include "ply_writer.hpp"
+#include "point_reader.hpp"
+#include "xyz_writer.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <fcntl.h>
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Best of `runs` timings of fn(); fn returns the number of points it saw.
+template <typename Fn> double bestSeconds(int runs, Fn&& fn) {
+    double best = 1e30;
+    for (int i = 0; i < runs; ++i) {
+        const auto start = Clock::now();
+        fn();
+        const double s = secondsSince(start);
+        best = s < best ? s : best;
+    }
+    return best;
+}
+
+std::uint64_t rawRead(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_RDONLY);
+    if (fd < 0) {
+        std::perror(path.c_str());
+        std::exit(1);
+    }
+    std::vector<char> block(4 << 20);
+    std::uint64_t total = 0;
+    for (;;) {
+        const ssize_t got = ::read(fd, block.data(), block.size());
+        if (got <= 0) {
+            break;
+        }
+        total += static_cast<std::uint64_t>(got);
+    }
+    ::close(fd);
+    return total;
+}
+
+std::uint64_t readAll(const std::string& path, const omicron::OpenOptions& options) {
+    auto reader = omicron::openPointCloud(path, options);
+    std::uint64_t points = 0;
+    reader->read([&](const omicron::PointBatch& batch) { points += batch.size(); });
+    return points;
+}
+
+void measure(const std::string& label, const std::string& path, int runs) {
+    const std::uint64_t bytes = std::filesystem::file_size(path);
+    rawRead(path); // warm the page cache
+    const double rawS = bestSeconds(runs, [&] { rawRead(path); });
+    const double rawMbPerS = bytes / rawS / 1e6;
+
+    std::uint64_t points = 0;
+    const double fullS = bestSeconds(runs, [&] { points = readAll(path, {}); });
+    const omicron::Bounds bounds = omicron::openPointCloud(path)->info().sourceBounds;
+    omicron::OpenOptions known;
+    known.knownBounds = bounds;
+    const double parseS = bestSeconds(runs, [&] { readAll(path, known); });
+
+    for (const auto& [phase, s] : {std::pair{"open_and_read", fullS}, {"parse", parseS}}) {
+        std::printf("bench=read reader=%s phase=%s points=%llu bytes=%llu bytes_per_point=%.1f "
+                    "ms=%.1f mpoints_per_s=%.2f mb_per_s=%.1f raw_mb_per_s=%.1f "
+                    "ratio_vs_raw=%.3f\n",
+                    label.c_str(), phase, static_cast<unsigned long long>(points),
+                    static_cast<unsigned long long>(bytes), double(bytes) / double(points),
+                    s * 1e3, points / s / 1e6, bytes / s / 1e6, rawMbPerS, rawS / s);
+    }
+    std::fflush(stdout);
+}
+
+std::string label(omicron::CloudFormat format) {
+    switch (format) {
+    case omicron::CloudFormat::PlyAscii: return "ply_ascii";
+    case omicron::CloudFormat::PlyBinaryLittleEndian: return "ply_binary_little_endian";
+    case omicron::CloudFormat::PlyBinaryBigEndian: return "ply_binary_big_endian";
+    case omicron::CloudFormat::Las: return "las";
+    case omicron::CloudFormat::Xyz: return "xyz";
+    }
+    return "unknown";
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2) {
+        std::fprintf(stderr, "usage: read_bench FILE [--keep-temp]\n");
+        return 2;
+    }
+    const std::string input = argv[1];
+    const bool keepTemp = argc > 2 && std::strcmp(argv[2], "--keep-temp") == 0;
+    try {
+        measure(label(omicron::detectFormat(input)), input, 3);
+
+        const omicron::LoadedCloud cloud = omicron::loadPointCloud(input);
+        const auto folder = std::filesystem::temp_directory_path() /
+                            ("omicron-read-bench-" + std::to_string(::getpid()));
+        std::filesystem::create_directories(folder);
+        const auto file = [&](const char* name) { return (folder / name).string(); };
+
+        omicron::PlyWriteOptions bigEndian;
+        bigEndian.encoding = omicron::PlyEncoding::BinaryBigEndian;
+        bigEndian.offset = cloud.info.sourceOffset;
+        omicron::writePly(file("big_endian.ply"), cloud.points, cloud.info.cube, bigEndian);
+        omicron::PlyWriteOptions ascii = bigEndian;
+        ascii.encoding = omicron::PlyEncoding::Ascii;
+        omicron::writePly(file("ascii.ply"), cloud.points, cloud.info.cube, ascii);
+        omicron::LasWriteOptions las;
+        las.versionMinor = 4;
+        las.pointFormat = 7;
+        las.scale = glm::dvec3(0.001);
+        las.offset = cloud.info.sourceOffset;
+        omicron::writeLas(file("cloud.las"), cloud.points, cloud.info.cube, las);
+        omicron::writeXyz(file("cloud.xyz"), cloud.points, cloud.info.cube,
+                          cloud.info.sourceOffset);
+
+        for (const char* name : {"big_endian.ply", "cloud.las", "ascii.ply", "cloud.xyz"}) {
+            measure(label(omicron::detectFormat(file(name))), file(name), 2);
+        }
+        if (!keepTemp) {
+            std::filesystem::remove_all(folder);
+        }
+    } catch (const std::exception& error) {
+        std::fprintf(stderr, "read_bench: %s\n", error.what());
+        return 1;
+    }
+    return 0;
+}

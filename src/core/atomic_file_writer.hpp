@@ -1,0 +1,50 @@
+// Writes a file so that the target is either the complete new file or untouched: bytes go to
+// a temporary file in the target's folder, commit() flushes, fsyncs and renames it over the
+// target. Destroyed without commit() (an error, an exception), the temporary is removed.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace omicron {
+
+// A failure to write an output file; what() names the file and the reason.
+class OutputError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+class AtomicFileWriter {
+public:
+    explicit AtomicFileWriter(std::string targetPath); // throws OutputError
+    ~AtomicFileWriter();
+    AtomicFileWriter(const AtomicFileWriter&) = delete;
+    AtomicFileWriter& operator=(const AtomicFileWriter&) = delete;
+
+    // Buffered; throws OutputError (disk full, I/O error) naming the target.
+    void write(const void* data, std::size_t count);
+    void write(const std::string& text) { write(text.data(), text.size()); }
+
+    std::uint64_t bytesWritten() const { return m_bytesWritten; }
+    const std::string& targetPath() const { return m_targetPath; }
+
+    // Flushes, fsyncs and renames onto the target; throws OutputError.
+    void commit();
+
+private:
+    void flushBuffer();
+    [[noreturn]] void fail(const std::string& what, int error);
+
+    std::string m_targetPath;
+    std::string m_tempPath;
+    int m_fd = -1;
+    std::vector<char> m_buffer;
+    std::size_t m_buffered = 0;
+    std::uint64_t m_bytesWritten = 0;
+    bool m_committed = false;
+};
+
+} // namespace omicron
