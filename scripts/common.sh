@@ -2,7 +2,7 @@
 # shellcheck shell=bash
 OMICRON_PACKAGES=(
   cmake ninja-build g++ pkg-config
-  qt6-base-dev libqt6opengl6-dev qt6-charts-dev libglm-dev libtbb-dev libgtest-dev
+  qt6-base-dev libqt6opengl6-dev qt6-charts-dev libglm-dev libtbb-dev libgtest-dev libxxhash-dev
   xvfb xauth libgl1-mesa-dri mesa-utils fonts-dejavu-core
   dpkg-dev file
 )
