@@ -87,19 +87,24 @@ void measure(const std::string& label, const std::string& path, int runs) {
                     "ms=%.1f mpoints_per_s=%.2f mb_per_s=%.1f raw_mb_per_s=%.1f "
                     "ratio_vs_raw=%.3f\n",
                     label.c_str(), phase, static_cast<unsigned long long>(points),
-                    static_cast<unsigned long long>(bytes), double(bytes) / double(points),
-                    s * 1e3, points / s / 1e6, bytes / s / 1e6, rawMbPerS, rawS / s);
+                    static_cast<unsigned long long>(bytes), double(bytes) / double(points), s * 1e3,
+                    points / s / 1e6, bytes / s / 1e6, rawMbPerS, rawS / s);
     }
     std::fflush(stdout);
 }
 
 std::string label(omicron::CloudFormat format) {
     switch (format) {
-    case omicron::CloudFormat::PlyAscii: return "ply_ascii";
-    case omicron::CloudFormat::PlyBinaryLittleEndian: return "ply_binary_little_endian";
-    case omicron::CloudFormat::PlyBinaryBigEndian: return "ply_binary_big_endian";
-    case omicron::CloudFormat::Las: return "las";
-    case omicron::CloudFormat::Xyz: return "xyz";
+    case omicron::CloudFormat::PlyAscii:
+        return "ply_ascii";
+    case omicron::CloudFormat::PlyBinaryLittleEndian:
+        return "ply_binary_little_endian";
+    case omicron::CloudFormat::PlyBinaryBigEndian:
+        return "ply_binary_big_endian";
+    case omicron::CloudFormat::Las:
+        return "las";
+    case omicron::CloudFormat::Xyz:
+        return "xyz";
     }
     return "unknown";
 }
@@ -120,11 +125,13 @@ int main(int argc, char** argv) {
         const auto folder = std::filesystem::temp_directory_path() /
                             ("omicron-read-bench-" + std::to_string(::getpid()));
         std::filesystem::create_directories(folder);
-        const auto file = [&](const char* name) { return (folder / name).string(); };
+        const auto file = [&](const char* name) {
+            return (folder / name).string();
+        };
 
         omicron::PlyWriteOptions bigEndian;
         bigEndian.encoding = omicron::PlyEncoding::BinaryBigEndian;
-        bigEndian.offset = cloud.info.sourceOffset;
+        bigEndian.offset = omicron::plyStorageOffset(cloud.info.cube, cloud.info.sourceOffset);
         omicron::writePly(file("big_endian.ply"), cloud.points, cloud.info.cube, bigEndian);
         omicron::PlyWriteOptions ascii = bigEndian;
         ascii.encoding = omicron::PlyEncoding::Ascii;

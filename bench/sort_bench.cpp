@@ -59,7 +59,9 @@ int main(int argc, char** argv) {
         const int threads = tbb::info::default_concurrency();
 
         std::vector<KeyIndex> work;
-        const auto resetWork = [&] { work = input; };
+        const auto resetWork = [&] {
+            work = input;
+        };
         const double stdSortS =
             bestSeconds(3, resetWork, [&] { std::sort(work.begin(), work.end()); });
         const double tbbSortS =
@@ -72,9 +74,8 @@ int main(int argc, char** argv) {
                 values[i] = input[i].index;
             }
         };
-        const double radixS = bestSeconds(3, resetKeys, [&] {
-            omicron::radixSortByKey(keys, values, keyScratch, valueScratch);
-        });
+        const double radixS = bestSeconds(
+            3, resetKeys, [&] { omicron::radixSortByKey(keys, values, keyScratch, valueScratch); });
         for (std::size_t i = 0; i < count; ++i) {
             if (keys[i] != work[i].code) {
                 std::fprintf(stderr, "sort_bench: radix sort disagrees with tbb::parallel_sort\n");
@@ -100,14 +101,12 @@ int main(int argc, char** argv) {
                 omicron::SortOptions options;
                 options.chunks = chunks;
                 std::size_t emitted = 0;
-                const omicron::SortSummary summary = omicron::sortPointCloud(
-                    *reader, options,
-                    [&](const omicron::SortedCloud&, std::size_t begin, std::size_t end) {
-                        emitted += end - begin;
-                    });
+                const omicron::SortSummary summary =
+                    omicron::sortPointCloud(*reader, options,
+                                            [&](const omicron::SortedCloud&, std::size_t begin,
+                                                std::size_t end) { emitted += end - begin; });
                 if (emitted != count) {
-                    std::fprintf(stderr, "sort_bench: %zu of %zu points emitted\n", emitted,
-                                 count);
+                    std::fprintf(stderr, "sort_bench: %zu of %zu points emitted\n", emitted, count);
                     return 1;
                 }
                 if (summary.sortAfterReadSeconds < best.sortAfterReadSeconds) {

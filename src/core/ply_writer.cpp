@@ -5,6 +5,8 @@
 #include <bit>
 #include <cassert>
 #include <charconv>
+#include <cmath>
+#include <glm/common.hpp>
 #include <cstdio>
 #include <cstring>
 
@@ -185,6 +187,16 @@ void writePly(const std::string& path, const PointBatch& points, const CubeTrans
         writeBinaryBody(out, points, cube, options);
     }
     out.commit();
+}
+
+glm::dvec3 plyStorageOffset(const CubeTransform& cube, const glm::dvec3& preferred) {
+    // float has a 24-bit mantissa: below 2^14 units, steps are finer than 0.001 units.
+    constexpr double kPreciseRange = 16384.0;
+    const glm::dvec3 low = cube.origin - preferred;
+    const glm::dvec3 high = low + glm::dvec3(cube.edge);
+    const double largest = std::max({std::abs(low.x), std::abs(low.y), std::abs(low.z),
+                                     std::abs(high.x), std::abs(high.y), std::abs(high.z)});
+    return largest <= kPreciseRange ? preferred : glm::floor(cube.origin);
 }
 
 } // namespace omicron

@@ -21,6 +21,11 @@ struct PlyWriteOptions {
     std::vector<std::string> comments; // extra "comment" lines
 };
 
+// The offset to store float coordinates against: `preferred` (e.g. the source file's own
+// offset) when float keeps millimetre steps relative to it, else the cube's origin rounded to
+// whole units, so georeferenced clouds (LAS with coordinates of 10^6) keep their precision.
+glm::dvec3 plyStorageOffset(const CubeTransform& cube, const glm::dvec3& preferred);
+
 // Writes every point of `points` (positions mapped back to source units with `cube`) with
 // the attributes the batch has: float x y z, float nx ny nz, uchar red green blue, ushort
 // intensity. Throws OutputError; the target is untouched on failure.

@@ -27,10 +27,10 @@ private:
 std::string sharedDataFile(const std::string& name);
 
 // Expands to GTEST_SKIP() with a message when ../shared/data/NAME is absent; else sets VAR.
-#define OMICRON_REQUIRE_SHARED_FILE(VAR, NAME)                                                    \
-    const std::string VAR = ::omicron::test::sharedDataFile(NAME);                                \
+#define OMICRON_REQUIRE_SHARED_FILE(VAR, NAME)                                                     \
+    const std::string VAR = ::omicron::test::sharedDataFile(NAME);                                 \
     if (VAR.empty()) {                                                                             \
-        GTEST_SKIP() << "shared data file " << (NAME) << " is absent (../shared/data); skipped";  \
+        GTEST_SKIP() << "shared data file " << (NAME) << " is absent (../shared/data); skipped";   \
     }
 
 void writeBytes(const std::string& path, const std::vector<std::uint8_t>& bytes);

@@ -1,0 +1,47 @@
+// Command-line parsing for omicron-cli's commands: "--name value", "--name=value", flags,
+// positional arguments and "--" (everything after it is positional).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace omicron::cli {
+
+// A mistake on the command line: main prints it with a usage hint and exits with status 2.
+class UsageError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+struct OptionSpec {
+    std::string name; // without the leading "--"
+    bool takesValue = false;
+};
+
+class ParsedArgs {
+public:
+    bool help = false; // --help or -h was given: print the command's help, ignore the rest
+    std::vector<std::string> positionals;
+
+    bool flag(std::string_view name) const;
+    std::optional<std::string> value(std::string_view name) const;
+
+    // Records an option; a repeated option keeps its last value.
+    void set(const std::string& name, std::string value);
+
+private:
+    std::vector<std::pair<std::string, std::string>> m_options;
+};
+
+// Throws UsageError for an unknown option or an option without its value.
+ParsedArgs parseArgs(const std::vector<std::string>& args, const std::vector<OptionSpec>& specs);
+
+// A decimal integer in [min, max] given to `--option`; throws UsageError naming the option.
+std::uint64_t parseInteger(const std::string& text, const std::string& option, std::uint64_t min,
+                           std::uint64_t max);
+
+} // namespace omicron::cli

@@ -1,0 +1,124 @@
+// omicron-cli as a user runs it: help, exit codes, info on every shared scan, generate.
+#include "run_process.hpp"
+#include "test_files.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <gtest/gtest.h>
+
+namespace omicron {
+namespace {
+
+using test::runProcess;
+
+TEST(CliBasics, HelpListsEveryCommandAndExitsZero) {
+    const auto result = runProcess(OMICRON_CLI_PATH, {"--help"});
+    EXPECT_EQ(result.exitCode, 0);
+    for (const char* command : {"info", "generate", "sort", "export"}) {
+        EXPECT_NE(result.out.find(command), std::string::npos) << command;
+        const auto help = runProcess(OMICRON_CLI_PATH, {command, "--help"});
+        EXPECT_EQ(help.exitCode, 0) << command;
+        EXPECT_NE(help.out.find("usage: omicron-cli"), std::string::npos) << command;
+    }
+}
+
+TEST(CliBasics, UsageErrorsExitTwoWithAReason) {
+    const auto noCommand = runProcess(OMICRON_CLI_PATH, {});
+    EXPECT_EQ(noCommand.exitCode, 2);
+    const auto unknown = runProcess(OMICRON_CLI_PATH, {"frobnicate"});
+    EXPECT_EQ(unknown.exitCode, 2);
+    EXPECT_NE(unknown.err.find("frobnicate"), std::string::npos);
+    const auto badOption = runProcess(OMICRON_CLI_PATH, {"info", "x.ply", "--fast"});
+    EXPECT_EQ(badOption.exitCode, 2);
+    EXPECT_NE(badOption.err.find("--fast"), std::string::npos) << badOption.err;
+    const auto badNumber = runProcess(OMICRON_CLI_PATH, {"generate", "--points", "many", "o.ply"});
+    EXPECT_EQ(badNumber.exitCode, 2);
+    const auto missingArgument = runProcess(OMICRON_CLI_PATH, {"info"});
+    EXPECT_EQ(missingArgument.exitCode, 2);
+}
+
+TEST(CliBasics, InputErrorsExitOneAndNameTheFile) {
+    test::TempDir dir;
+    const std::string missing = dir.file("missing.ply");
+    const auto result = runProcess(OMICRON_CLI_PATH, {"info", missing});
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_NE(result.err.find(missing), std::string::npos) << result.err;
+    const auto directory = runProcess(OMICRON_CLI_PATH, {"info", dir.path().string()});
+    EXPECT_EQ(directory.exitCode, 1);
+    EXPECT_NE(directory.err.find("directory"), std::string::npos) << directory.err;
+    const std::string laz = dir.file("scan.laz");
+    test::writeText(laz, "not really compressed");
+    const auto lazResult = runProcess(OMICRON_CLI_PATH, {"info", laz});
+    EXPECT_EQ(lazResult.exitCode, 1);
+    EXPECT_NE(lazResult.err.find("LAZ"), std::string::npos) << lazResult.err;
+}
+
+TEST(CliGenerate, GeneratedCloudReadsBackWithItsExactCount) {
+    test::TempDir dir;
+    const std::string out = dir.file("scene.ply");
+    const auto generated =
+        runProcess(OMICRON_CLI_PATH, {"generate", "--points", "20000", "--seed", "3", out});
+    ASSERT_EQ(generated.exitCode, 0) << generated.err;
+    const auto info = runProcess(OMICRON_CLI_PATH, {"info", out, "--json"});
+    ASSERT_EQ(info.exitCode, 0) << info.err;
+    EXPECT_NE(info.out.find("\"points_read\":20000"), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("\"attributes\":[\"normal\",\"color\"]"), std::string::npos)
+        << info.out;
+    // Deterministic: the same arguments write the same bytes.
+    const std::string again = dir.file("again.ply");
+    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"generate", "--points", "20000", "--seed", "3", again})
+                  .exitCode,
+              0);
+    EXPECT_EQ(test::readBytes(out), test::readBytes(again));
+}
+
+struct SharedFileCount {
+    const char* name;
+    const char* points;
+};
+
+class CliInfoSharedData : public ::testing::TestWithParam<SharedFileCount> {};
+
+TEST_P(CliInfoSharedData, PrintsTheRightCount) {
+    OMICRON_REQUIRE_SHARED_FILE(path, GetParam().name);
+    const auto text = runProcess(OMICRON_CLI_PATH, {"info", path});
+    ASSERT_EQ(text.exitCode, 0) << text.err;
+    const std::string expected = std::string(GetParam().points) + " declared, " +
+                                 GetParam().points + " read, 0 non-finite skipped";
+    EXPECT_NE(text.out.find(expected), std::string::npos) << text.out;
+    const auto json = runProcess(OMICRON_CLI_PATH, {"info", path, "--json"});
+    ASSERT_EQ(json.exitCode, 0) << json.err;
+    EXPECT_NE(json.out.find(std::string("\"points_read\":") + GetParam().points), std::string::npos)
+        << json.out;
+}
+
+INSTANTIATE_TEST_SUITE_P(Files, CliInfoSharedData,
+                         ::testing::Values(SharedFileCount{"bunny.ply", "35947"},
+                                           SharedFileCount{"autzen_trim.ply", "110000"},
+                                           SharedFileCount{"autzen_trim.las", "110000"},
+                                           SharedFileCount{"lion.ply", "341989"},
+                                           SharedFileCount{"sorvilier.ply", "498868"},
+                                           SharedFileCount{"indoor.ply", "808042"},
+                                           SharedFileCount{"dragon.ply", "437645"},
+                                           SharedFileCount{"autzen_south.ply", "4844261"}),
+                         [](const auto& info) {
+                             std::string name = info.param.name;
+                             std::replace(name.begin(), name.end(), '.', '_');
+                             return name;
+                         });
+
+TEST(CliInfo, UnderstandsSortedStreams) {
+    OMICRON_REQUIRE_SHARED_FILE(input, "autzen_trim.las");
+    test::TempDir dir;
+    const std::string oms = dir.file("s.oms");
+    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"sort", input, oms}).exitCode, 0);
+    const auto info = runProcess(OMICRON_CLI_PATH, {"info", oms, "--json"});
+    ASSERT_EQ(info.exitCode, 0) << info.err;
+    EXPECT_NE(info.out.find("\"format\":\"OMS sorted stream\""), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("\"points_read\":110000"), std::string::npos) << info.out;
+    // Bounds recovered from the sorted points match the LAS header within float precision.
+    EXPECT_NE(info.out.find("\"min\":[636001.7"), std::string::npos) << info.out;
+}
+
+} // namespace
+} // namespace omicron

@@ -1,0 +1,126 @@
+// omicron-cli sort and export, run as real processes on every shared scan: the exported PLY
+// holds the input's points in non-decreasing Morton order of the input's cube.
+#include "oms_reader.hpp"
+#include "point_reader.hpp"
+#include "run_process.hpp"
+#include "test_files.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <filesystem>
+#include <gtest/gtest.h>
+
+namespace omicron {
+namespace {
+
+using test::runProcess;
+
+std::array<std::uint32_t, 3> bitsOf(const glm::vec3& p) {
+    std::array<std::uint32_t, 3> bits;
+    std::memcpy(bits.data(), &p, sizeof bits);
+    return bits;
+}
+
+class CliSortExport : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(CliSortExport, ExportedPointsAreTheInputInMortonOrder) {
+    OMICRON_REQUIRE_SHARED_FILE(input, GetParam());
+    test::TempDir dir;
+    const std::string oms = dir.file("sorted.oms");
+    const std::string ply = dir.file("exported.ply");
+
+    const auto sorted = runProcess(OMICRON_CLI_PATH, {"sort", input, oms, "--chunks", "16"});
+    ASSERT_EQ(sorted.exitCode, 0) << sorted.err;
+    EXPECT_NE(sorted.err.find("sorted and written"), std::string::npos) << "no progress line";
+    const auto exported = runProcess(OMICRON_CLI_PATH, {"export", oms, ply});
+    ASSERT_EQ(exported.exitCode, 0) << exported.err;
+
+    // The .oms holds exactly the reader's unit-cube positions, in Morton order.
+    const LoadedCloud original = loadPointCloud(input);
+    OmsReader reader(oms);
+    reader.read([](const SortedCloud&, std::size_t, std::size_t) {});
+    const auto cloud = reader.cloud();
+    ASSERT_EQ(cloud->sortedEnd(), original.points.size());
+    EXPECT_EQ(cloud->cube(), original.info.cube);
+    std::vector<std::array<std::uint32_t, 3>> in, out;
+    for (std::size_t i = 0; i < cloud->sortedEnd(); ++i) {
+        const glm::vec3& p = cloud->positions()[i];
+        if (i > 0) {
+            const glm::vec3& q = cloud->positions()[i - 1];
+            ASSERT_LE(morton::encodeUnit(q.x, q.y, q.z), morton::encodeUnit(p.x, p.y, p.z))
+                << "point " << i << " out of Morton order";
+        }
+        out.push_back(bitsOf(p));
+    }
+    for (const glm::vec3& p : original.points.positions) {
+        in.push_back(bitsOf(p));
+    }
+    std::sort(in.begin(), in.end());
+    std::sort(out.begin(), out.end());
+    ASSERT_TRUE(in == out) << "the sorted file is not a permutation of the input";
+
+    // The PLY holds those points in the same order, in source units (float storage).
+    const LoadedCloud plyCloud = loadPointCloud(ply);
+    ASSERT_EQ(plyCloud.points.size(), cloud->sortedEnd());
+    const double tolerance = 1e-6 * original.info.cube.edge + 1e-4;
+    for (std::size_t i = 0; i < plyCloud.points.size(); ++i) {
+        const glm::dvec3 expected = cloud->cube().toSource(cloud->positions()[i]);
+        const glm::dvec3 actual = plyCloud.info.cube.toSource(plyCloud.points.positions[i]);
+        ASSERT_NEAR(actual.x, expected.x, tolerance) << "point " << i;
+        ASSERT_NEAR(actual.y, expected.y, tolerance) << "point " << i;
+        ASSERT_NEAR(actual.z, expected.z, tolerance) << "point " << i;
+    }
+    EXPECT_EQ(plyCloud.info.attributes, original.info.attributes);
+}
+
+INSTANTIATE_TEST_SUITE_P(Files, CliSortExport,
+                         ::testing::Values("bunny.ply", "autzen_trim.ply", "autzen_trim.las",
+                                           "lion.ply", "sorvilier.ply", "indoor.ply", "dragon.ply",
+                                           "autzen_south.ply"),
+                         [](const auto& info) {
+                             std::string name = info.param;
+                             std::replace(name.begin(), name.end(), '.', '_');
+                             return name;
+                         });
+
+TEST(CliSort, BadInputFailsWithExitOneAndLeavesNoOutput) {
+    test::TempDir dir;
+    const std::string broken = dir.file("broken.ply");
+    test::writeText(broken, "ply\nformat binary_little_endian 1.0\nelement vertex 10\n"
+                            "property float x\nproperty float y\nproperty float z\nend_header\n");
+    const std::string oms = dir.file("out.oms");
+    const auto result = runProcess(OMICRON_CLI_PATH, {"sort", broken, oms});
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_NE(result.err.find(broken), std::string::npos) << result.err;
+    EXPECT_FALSE(std::filesystem::exists(oms));
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 1)
+        << "a temporary file was left behind";
+}
+
+TEST(CliSort, UsageErrorsExitTwo) {
+    EXPECT_EQ(runProcess(OMICRON_CLI_PATH, {"sort", "only-one-argument"}).exitCode, 2);
+    EXPECT_EQ(runProcess(OMICRON_CLI_PATH, {"sort", "a.ply", "b.oms", "--chunks", "0"}).exitCode,
+              2);
+    EXPECT_EQ(runProcess(OMICRON_CLI_PATH, {"sort", "a.ply", "b.oms", "--chunks", "257"}).exitCode,
+              2);
+    EXPECT_EQ(runProcess(OMICRON_CLI_PATH, {"export", "a.oms"}).exitCode, 2);
+}
+
+TEST(CliExport, CorruptedSortedFileFailsWithExitOne) {
+    OMICRON_REQUIRE_SHARED_FILE(input, "bunny.ply");
+    test::TempDir dir;
+    const std::string oms = dir.file("sorted.oms");
+    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"sort", input, oms}).exitCode, 0);
+    auto bytes = test::readBytes(oms);
+    bytes[bytes.size() / 2] ^= 0x5a;
+    test::writeBytes(oms, bytes);
+    const std::string ply = dir.file("out.ply");
+    const auto result = runProcess(OMICRON_CLI_PATH, {"export", oms, ply});
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_NE(result.err.find(oms), std::string::npos) << result.err;
+    EXPECT_FALSE(std::filesystem::exists(ply));
+}
+
+} // namespace
+} // namespace omicron
