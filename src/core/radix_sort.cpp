@@ -66,7 +66,8 @@ std::uint64_t varyingBits(const Range& r) {
 }
 
 // Stable counting scatter of r.keys/values into r.keyScratch/valueScratch by the digit
-// (key >> shift) & (digits - 1). Returns where each bucket starts, plus the end.
+// (key >> shift) & (digits - 1). Returns where each bucket starts, plus the end; returns an
+// empty vector, having moved nothing, when every key has the same digit.
 std::vector<std::size_t> scatterByDigit(const Range& r, int shift, std::size_t digits) {
     const std::uint64_t mask = digits - 1;
     const auto digitOf = [&](std::uint64_t key) {
@@ -97,6 +98,9 @@ std::vector<std::size_t> scatterByDigit(const Range& r, int shift, std::size_t d
         bucketBegin[digit] = offset;
         for (std::size_t block = 0; block < blocks; ++block) {
             const std::size_t n = counts[block * digits + digit];
+            if (n == r.count) {
+                return {};
+            }
             counts[block * digits + digit] = offset;
             offset += n;
         }
@@ -114,12 +118,12 @@ std::vector<std::size_t> scatterByDigit(const Range& r, int shift, std::size_t d
     return bucketBegin;
 }
 
-void sortInto(const Range& from, const Range& into);
+void sortInto(const Range& from, const Range& into, int topBit);
 
-// The digit is the highest bits in which keys differ. Large ranges (scattered across memory
-// by all threads) use 8 bits: 256 write streams stay cache- and TLB-friendly. Cache-resident
-// ranges use up to 11 bits, sized so that buckets come out small enough for insertion sort
-// (measured in bench/sort_bench: fewer levels beat smaller histograms there).
+// Digit width: large ranges (scattered across memory by all threads) use 8 bits, so 256
+// write streams stay cache- and TLB-friendly; cache-resident ranges use up to 11 bits, sized
+// so that buckets come out small enough for insertion sort (measured in bench/sort_bench:
+// fewer levels beat smaller histograms there).
 int digitBitsFor(std::size_t count) {
     if (count >= kParallelMin) {
         return 8;
@@ -127,71 +131,92 @@ int digitBitsFor(std::size_t count) {
     return std::clamp(static_cast<int>(std::bit_width(count)) - 4, 3, 11);
 }
 
+// Finds the digit to distribute `r` by, knowing every key agrees on the bits at and above
+// `topBit`, and scatters r.keys into r.keyScratch by it. Small ranges first find the highest
+// varying bit (one pass in cache); large ones skip that full pass and try digits from the top,
+// a digit on which all keys agree costing only its histogram. Returns the bucket starts and
+// the digit's shift, or no buckets when all keys are equal.
+std::pair<std::vector<std::size_t>, int> distribute(const Range& r, int topBit) {
+    if (r.count < kParallelMin) {
+        const std::uint64_t below = topBit >= 64 ? ~0ull : (std::uint64_t{1} << topBit) - 1;
+        const std::uint64_t varying = varyingBits(r) & below;
+        if (varying == 0) {
+            return {};
+        }
+        topBit = 64 - std::countl_zero(varying);
+    }
+    while (topBit > 0) {
+        const int digitBits = std::min(digitBitsFor(r.count), topBit);
+        const int shift = topBit - digitBits;
+        std::vector<std::size_t> buckets = scatterByDigit(r, shift, std::size_t{1} << digitBits);
+        if (!buckets.empty()) {
+            return {std::move(buckets), shift};
+        }
+        topBit = shift;
+    }
+    return {};
+}
+
+template <typename Body> void forEachBucket(std::size_t count, std::size_t buckets, Body&& body) {
+    if (count >= kParallelMin) {
+        tbb::parallel_for(std::size_t{0}, buckets, body);
+    } else {
+        for (std::size_t bucket = 0; bucket < buckets; ++bucket) {
+            body(bucket);
+        }
+    }
+}
+
 // Sorts the keys of `r` in place (r.keys/values), using r.keyScratch/valueScratch.
-void sortInPlace(const Range& r) {
+void sortInPlace(const Range& r, int topBit) {
     if (r.count <= kInsertionSortMax) {
         insertionSort(r);
         return;
     }
-    const std::uint64_t varying = varyingBits(r);
-    if (varying == 0) {
+    const auto [bucketBegin, shift] = distribute(r, topBit);
+    if (bucketBegin.empty()) {
         return; // all keys equal: already in (stable) order
     }
-    const int digitBits = digitBitsFor(r.count);
-    const int shift = std::max(64 - std::countl_zero(varying) - digitBits, 0);
-    const std::size_t digits = std::size_t{1} << digitBits;
-    const std::vector<std::size_t> bucketBegin = scatterByDigit(r, shift, digits);
-
     // Each bucket now sits in the scratch arrays; sorting it writes it back into place, so
     // no level copies the data back separately.
-    const auto sortBucket = [&](std::size_t digit) {
+    forEachBucket(r.count, bucketBegin.size() - 1, [&](std::size_t digit) {
         const std::size_t begin = bucketBegin[digit];
         const std::size_t size = bucketBegin[digit + 1] - begin;
         if (size > 0) {
             const Range bucket = r.sub(begin, size);
             sortInto({bucket.keyScratch, bucket.valueScratch, bucket.keys, bucket.values, size},
-                     bucket);
+                     bucket, shift);
         }
-    };
-    if (r.count >= kParallelMin) {
-        tbb::parallel_for(std::size_t{0}, digits, sortBucket);
-    } else {
-        for (std::size_t digit = 0; digit < digits; ++digit) {
-            sortBucket(digit);
-        }
-    }
+    });
 }
 
 // Sorts the keys held in from.keys/values into into.keys/values (same count); the arrays of
 // `from` serve as scratch.
-void sortInto(const Range& from, const Range& into) {
-    const std::uint64_t varying = from.count <= kInsertionSortMax ? ~0ull : varyingBits(from);
-    if (from.count <= kInsertionSortMax || varying == 0) {
+void sortInto(const Range& from, const Range& into, int topBit) {
+    const auto finishInInto = [&] {
         std::copy_n(from.keys, from.count, into.keys);
         std::copy_n(from.values, from.count, into.values);
-        insertionSort(into); // a no-op pass when all keys are equal
+        insertionSort(into); // linear when the keys are already in order
+    };
+    if (from.count <= kInsertionSortMax) {
+        finishInInto();
         return;
     }
-    const int digitBits = digitBitsFor(from.count);
-    const int shift = std::max(64 - std::countl_zero(varying) - digitBits, 0);
-    const std::size_t digits = std::size_t{1} << digitBits;
-    const std::vector<std::size_t> bucketBegin =
-        scatterByDigit({from.keys, from.values, into.keys, into.values, from.count}, shift, digits);
-    const auto sortBucket = [&](std::size_t digit) {
+    const auto [bucketBegin, shift] =
+        distribute({from.keys, from.values, into.keys, into.values, from.count}, topBit);
+    if (bucketBegin.empty()) {
+        finishInInto();
+        return;
+    }
+    forEachBucket(from.count, bucketBegin.size() - 1, [&](std::size_t digit) {
         const std::size_t begin = bucketBegin[digit];
         const std::size_t size = bucketBegin[digit + 1] - begin;
         if (size > 0) {
             sortInPlace({into.keys + begin, into.values + begin, from.keys + begin,
-                         from.values + begin, size});
+                         from.values + begin, size},
+                        shift);
         }
-    };
-    if (from.count >= kParallelMin) {
-        tbb::parallel_for(std::size_t{0}, digits, sortBucket);
-    } else {
-        for (std::size_t digit = 0; digit < digits; ++digit) {
-            sortBucket(digit);
-        }
-    }
+    });
 }
 
 } // namespace
@@ -203,7 +228,8 @@ void radixSortByKey(std::span<std::uint64_t> keys, std::span<std::uint32_t> valu
     if (keys.size() < 2) {
         return;
     }
-    sortInPlace({keys.data(), values.data(), keyScratch.data(), valueScratch.data(), keys.size()});
+    sortInPlace({keys.data(), values.data(), keyScratch.data(), valueScratch.data(), keys.size()},
+                64);
 }
 
 } // namespace omicron
