@@ -19,6 +19,7 @@ const Command& infoCommand();
 const Command& generateCommand();
 const Command& sortCommand();
 const Command& exportCommand();
+const Command& buildCommand();
 
 // Prints "usage: omicron-cli USAGE" and the help text to stdout (for --help).
 void printCommandHelp(const Command& command);

@@ -19,10 +19,11 @@ using omicron::cli::Command;
 constexpr int kExitInputOutput = 1;
 constexpr int kExitUsage = 2;
 
-const std::array<const Command*, 4>& commands() {
-    static const std::array<const Command*, 4> all{
+const std::array<const Command*, 5>& commands() {
+    static const std::array<const Command*, 5> all{
         &omicron::cli::infoCommand(), &omicron::cli::generateCommand(),
-        &omicron::cli::sortCommand(), &omicron::cli::exportCommand()};
+        &omicron::cli::sortCommand(), &omicron::cli::exportCommand(),
+        &omicron::cli::buildCommand()};
     return all;
 }
 

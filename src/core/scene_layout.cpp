@@ -347,9 +347,12 @@ ScenePoint SceneLayout::sampleTerrain(SceneRandom& random) const {
         // Lush low ground, drier grass higher up, soil patches, rock on steep slopes, a road.
         const double altitude = smoothstep(-12.0, 12.0, height);
         glm::dvec3 color = glm::mix(glm::dvec3(60, 110, 35), glm::dvec3(125, 150, 70), altitude);
-        const double soilPattern = 0.5 + 0.5 * std::sin(0.13 * p.x + 0.5 * std::sin(0.07 * p.y)) *
-                                             std::cos(0.11 * p.y - 0.3 * std::sin(0.05 * p.x));
-        color = glm::mix(color, glm::dvec3(125, 100, 70), smoothstep(0.62, 0.8, soilPattern));
+        // Incommensurate, domain-warped waves: irregular patches rather than a grid of spots.
+        const double soilPattern =
+            std::sin(0.047 * p.x + 1.7 * std::sin(0.021 * p.y)) *
+                std::sin(0.061 * p.y + 1.3 * std::sin(0.033 * p.x)) +
+            0.35 * std::sin(0.13 * p.x + 0.09 * p.y + 2.0 * std::sin(0.05 * p.y));
+        color = glm::mix(color, glm::dvec3(125, 100, 70), smoothstep(0.55, 0.85, soilPattern));
         color = glm::mix(color, glm::dvec3(135, 130, 120),
                          smoothstep(0.97, 0.93, point.normal.z));
         if (onRoad(p)) {

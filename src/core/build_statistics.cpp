@@ -1,0 +1,29 @@
+#include "build_statistics.hpp"
+
+namespace omicron {
+
+std::uint64_t BuildStatistics::totalNodes() const {
+    std::uint64_t total = 0;
+    for (const LevelStatistics& level : levels) {
+        total += level.nodes;
+    }
+    return total;
+}
+
+std::size_t sortedCloudBytes(const SortedCloud& cloud) {
+    return cloud.codes().size_bytes() + cloud.positions().size_bytes() +
+           cloud.normals().size_bytes() + cloud.colors().size_bytes() +
+           cloud.intensities().size_bytes();
+}
+
+void recordMilestones(std::array<double, 10>& milestones, std::uint64_t inserted,
+                      std::uint64_t total, double seconds) {
+    for (std::size_t decile = 0; decile < milestones.size(); ++decile) {
+        // inserted / total >= (decile + 1) / 10, in integers.
+        if (milestones[decile] < 0.0 && total > 0 && inserted * 10 >= total * (decile + 1)) {
+            milestones[decile] = seconds;
+        }
+    }
+}
+
+} // namespace omicron

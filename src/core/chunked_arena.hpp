@@ -1,0 +1,60 @@
+// An append-only array whose elements never move, readable while one thread appends.
+//
+// Elements live in fixed-size chunks; the table of chunk pointers is allocated once, for the
+// capacity given at construction, so appending never reallocates anything a reader may be
+// looking at (std::vector moves its elements, std::deque reallocates its map). The arena does
+// no synchronisation of its own: the writer publishes a count with a release store (see
+// Hierarchy), and a reader only indexes below a count it loaded with acquire.
+#pragma once
+
+#include <cassert>
+#include <cstddef>
+#include <memory>
+
+namespace omicron {
+
+template <typename T, std::size_t ChunkElements> class ChunkedArena {
+    static_assert(ChunkElements > 0 && (ChunkElements & (ChunkElements - 1)) == 0,
+                  "chunk size must be a power of two (index split by shift and mask)");
+
+public:
+    explicit ChunkedArena(std::size_t capacity)
+        : m_capacity(capacity), m_chunks(std::make_unique<std::unique_ptr<T[]>[]>(
+                                    (capacity + ChunkElements - 1) / ChunkElements)) {}
+
+    ChunkedArena(const ChunkedArena&) = delete;
+    ChunkedArena& operator=(const ChunkedArena&) = delete;
+
+    std::size_t capacity() const { return m_capacity; }
+    // Writer side: elements appended so far (readers use the published count instead).
+    std::size_t size() const { return m_size; }
+
+    // Writer only. Returns the new element's index.
+    std::size_t push_back(const T& value) {
+        assert(m_size < m_capacity);
+        const std::size_t chunk = m_size / ChunkElements;
+        if (m_size % ChunkElements == 0) {
+            m_chunks[chunk] = std::make_unique<T[]>(ChunkElements);
+            ++m_chunksAllocated;
+        }
+        m_chunks[chunk][m_size % ChunkElements] = value;
+        return m_size++;
+    }
+
+    const T& operator[](std::size_t index) const {
+        return m_chunks[index / ChunkElements][index % ChunkElements];
+    }
+
+    std::size_t bytesAllocated() const {
+        return m_chunksAllocated * ChunkElements * sizeof(T) +
+               (m_capacity + ChunkElements - 1) / ChunkElements * sizeof(std::unique_ptr<T[]>);
+    }
+
+private:
+    std::size_t m_capacity;
+    std::size_t m_size = 0;
+    std::size_t m_chunksAllocated = 0;
+    std::unique_ptr<std::unique_ptr<T[]>[]> m_chunks;
+};
+
+} // namespace omicron

@@ -1,0 +1,99 @@
+#include "hierarchy.hpp"
+
+#include <algorithm>
+#include <cassert>
+
+namespace omicron {
+
+Hierarchy::Hierarchy(std::shared_ptr<const SortedCloud> cloud, int maxLevel)
+    : m_cloud(std::move(cloud)), m_maxLevel(maxLevel), m_splats(*m_cloud) {
+    assert(maxLevel >= 0 && maxLevel <= morton::kMaxLevel);
+    m_levels.reserve(static_cast<std::size_t>(maxLevel) + 1);
+    for (int level = 0; level <= maxLevel; ++level) {
+        // Every node covers at least one point, and a level has at most 8^level cells.
+        const std::uint64_t cells = std::uint64_t{1} << (3 * level);
+        const std::size_t capacity =
+            static_cast<std::size_t>(std::min<std::uint64_t>(cells, m_cloud->capacity()));
+        m_levels.push_back(std::make_unique<Level>(capacity));
+    }
+}
+
+std::optional<std::size_t> Hierarchy::findNode(morton::Code code, std::size_t count) const {
+    const int level = morton::level(code);
+    if (level > m_maxLevel) {
+        return std::nullopt;
+    }
+    const auto& nodes = m_levels[level]->nodes;
+    std::size_t low = 0, high = count;
+    while (low < high) {
+        const std::size_t mid = low + (high - low) / 2;
+        if (nodes[mid].code < code) {
+            low = mid + 1;
+        } else {
+            high = mid;
+        }
+    }
+    if (low < count && nodes[low].code == code) {
+        return low;
+    }
+    return std::nullopt;
+}
+
+PublishedCut Hierarchy::publishedCut() const {
+    PublishedCut cut;
+    cut.complete = m_complete.load(std::memory_order_acquire);
+    cut.epoch = m_epoch.load(std::memory_order_acquire);
+    cut.delimiter = m_cutDelimiter.load(std::memory_order_acquire);
+    for (int level = 1; level <= m_maxLevel; ++level) {
+        cut.fixedThrough[level] = fixedThrough(level);
+    }
+    return cut;
+}
+
+bool Hierarchy::isSettled(morton::Code code, const PublishedCut& cut, int maxLevel) {
+    if (cut.complete) {
+        return true;
+    }
+    const int level = morton::level(code);
+    return level >= 2 && cut.fixedThrough[level - 1] != 0 &&
+           morton::span(code >> 6, maxLevel) <= cut.fixedThrough[level - 1];
+}
+
+std::size_t Hierarchy::appendNode(int level, const OctreeNode& node) {
+    auto& nodes = m_levels[level]->nodes;
+    assert(node.level() == level);
+    assert(nodes.size() == 0 || nodes[nodes.size() - 1].code < node.code);
+    return nodes.push_back(node);
+}
+
+void Hierarchy::publishNodes(int level) {
+    Level& storage = *m_levels[level];
+    if (storage.published.load(std::memory_order_relaxed) != storage.nodes.size()) {
+        storage.published.store(storage.nodes.size(), std::memory_order_release);
+        bumpEpoch();
+    }
+}
+
+void Hierarchy::publishFixedThrough(int level, morton::Code delimiter) {
+    m_levels[level]->fixedThrough.store(delimiter, std::memory_order_release);
+}
+
+void Hierarchy::publishCutDelimiter(morton::Code delimiter) {
+    m_cutDelimiter.store(delimiter, std::memory_order_release);
+    bumpEpoch();
+}
+
+void Hierarchy::markComplete() {
+    m_complete.store(true, std::memory_order_release);
+    bumpEpoch();
+}
+
+std::size_t Hierarchy::nodeBytes() const {
+    std::size_t bytes = 0;
+    for (const auto& level : m_levels) {
+        bytes += level->nodes.bytesAllocated();
+    }
+    return bytes;
+}
+
+} // namespace omicron

@@ -1,0 +1,121 @@
+// The octree while it is being built: per-level node arrays that a renderer reads without
+// locks while the builder appends.
+//
+// Nodes of one level are stored in Morton order (the builder creates them in that order: see
+// oblique_cut.hpp), in a ChunkedArena that never moves them, so the children of a node are one
+// index range of the next level and a node is found by binary search. Publication protocol:
+//   - the builder fully writes nodes (and their samples and splat attributes), then stores the
+//     level's node count with release: a reader that loads nodeCount() with acquire may read
+//     every node below it, forever unchanged;
+//   - after creating the parents of level l's roots up to a delimiter, the builder publishes
+//     fixedThrough(l); after a whole fix pass, cutDelimiter() (the paper's m_C); both release.
+// What a render front may hold (invariant 2.2: no root of the cut, no child of a root) follows
+// from these delimiters alone: see isSettled().
+#pragma once
+
+#include "chunked_arena.hpp"
+#include "octree_node.hpp"
+#include "sample_store.hpp"
+#include "sorted_cloud.hpp"
+#include "splat_attributes.hpp"
+
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <vector>
+
+namespace omicron {
+
+// A view of the published cut (load it once per front evaluation). Each value only grows.
+struct PublishedCut {
+    morton::Code delimiter = 0; // m_C of the last complete fix pass; 0 before the first
+    // Per level l >= 1: the delimiter level l was last fixed with (fixedThrough(l)). Passes
+    // that stop part way up for new input (multipass) advance the deep levels only.
+    std::array<morton::Code, morton::kMaxLevel + 1> fixedThrough{};
+    std::uint64_t epoch = 0; // bumped whenever anything is published
+    bool complete = false;   // the build finished: every node is settled
+};
+
+class Hierarchy {
+public:
+    static constexpr std::size_t kNodesPerChunk = 1024;
+
+    Hierarchy(std::shared_ptr<const SortedCloud> cloud, int maxLevel);
+
+    Hierarchy(const Hierarchy&) = delete;
+    Hierarchy& operator=(const Hierarchy&) = delete;
+
+    int maxLevel() const { return m_maxLevel; }
+    const SortedCloud& cloud() const { return *m_cloud; }
+    const std::shared_ptr<const SortedCloud>& sharedCloud() const { return m_cloud; }
+    const SplatAttributes& splats() const { return m_splats; }
+
+    // ---- Reader side: any thread, no locks. ----
+
+    // Published nodes of `level` (acquire). Nodes [0, nodeCount) are complete and immutable.
+    std::size_t nodeCount(int level) const {
+        return m_levels[level]->published.load(std::memory_order_acquire);
+    }
+    // `index` must be below a nodeCount(level) this thread loaded.
+    const OctreeNode& node(int level, std::size_t index) const {
+        return m_levels[level]->nodes[index];
+    }
+    // Index of the node with `code` among the first `count` nodes of its level (Morton order).
+    std::optional<std::size_t> findNode(morton::Code code, std::size_t count) const;
+
+    PublishedCut publishedCut() const;
+    // Every root of level `level` has a parent with span > fixedThrough(level); every sibling
+    // group with parent span <= it has its parent (acquire). 0 before level's first fix.
+    morton::Code fixedThrough(int level) const {
+        return m_levels[level]->fixedThrough.load(std::memory_order_acquire);
+    }
+
+    // True when a published node with `code` is neither a root of the cut nor a child of one,
+    // so its parent and grandparent exist, never change, and it may enter a render front
+    // (invariant 2.2): span(grandparent) <= cut.fixedThrough[level - 1] (the grandparent was
+    // made when level - 1 was fixed), or the build is complete. The children of a settled
+    // node are settled. Using cut.delimiter instead (the paper's single m_C) is also correct,
+    // only more conservative.
+    static bool isSettled(morton::Code code, const PublishedCut& cut, int maxLevel);
+
+    // ---- Builder side: one thread. ----
+
+    // Appends a complete node to `level` (Morton order). Not visible before publishNodes().
+    std::size_t appendNode(int level, const OctreeNode& node);
+    std::size_t builtNodeCount(int level) const { return m_levels[level]->nodes.size(); }
+    std::uint32_t* allocateSamples(std::size_t count) { return m_samples.allocate(count); }
+    SplatAttributes& mutableSplats() { return m_splats; }
+
+    void publishNodes(int level);
+    void publishFixedThrough(int level, morton::Code delimiter);
+    void publishCutDelimiter(morton::Code delimiter);
+    void markComplete();
+
+    // Memory held by the hierarchy itself (the SortedCloud it indexes is not included).
+    std::size_t nodeBytes() const;
+    std::size_t sampleBytes() const { return m_samples.bytesAllocated(); }
+    std::size_t splatBytes() const { return m_splats.bytesResident(); }
+
+private:
+    struct Level {
+        explicit Level(std::size_t capacity) : nodes(capacity) {}
+        ChunkedArena<OctreeNode, kNodesPerChunk> nodes;
+        std::atomic<std::size_t> published{0};
+        std::atomic<morton::Code> fixedThrough{0};
+    };
+
+    void bumpEpoch() { m_epoch.fetch_add(1, std::memory_order_release); }
+
+    std::shared_ptr<const SortedCloud> m_cloud;
+    int m_maxLevel;
+    std::vector<std::unique_ptr<Level>> m_levels;
+    SampleStore m_samples;
+    SplatAttributes m_splats;
+    std::atomic<morton::Code> m_cutDelimiter{0};
+    std::atomic<std::uint64_t> m_epoch{0};
+    std::atomic<bool> m_complete{false};
+};
+
+} // namespace omicron

@@ -1,0 +1,511 @@
+#include "hierarchy_builder.hpp"
+
+#include "cut_invariants.hpp"
+#include "leaf_runs.hpp"
+#include "parent_sampler.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cassert>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+namespace omicron {
+
+namespace {
+
+// Input cut into leaves per pass, at most: bounds the latency of a pass (and of cancel()),
+// so that a builder that fell behind still publishes in steps.
+constexpr std::size_t kMaxInsertPoints = std::size_t{1} << 18;
+
+// What a worker makes of one sibling group, before the master publishes it.
+struct ParentDraft {
+    OctreeNode node; // sampleIndices not set: the sample is in the owning result
+    std::uint32_t sampleOffset = 0;
+    bool sampled = false;           // node holds a sample (copied at commit)
+    bool substituted = false;       // a placeholder became its leaf here
+    bool risingPlaceholder = false; // no node: the placeholder moves up as `root`
+    CutRoot root;
+
+    morton::Code code() const { return risingPlaceholder ? root.code : node.code; }
+};
+
+struct WorklistResult {
+    std::vector<ParentDraft> drafts;
+    std::vector<std::uint32_t> samples;
+    void clear() {
+        drafts.clear();
+        samples.clear();
+    }
+};
+
+// The parent (or substituted leaf, or risen placeholder) replacing `group` of level
+// parentLevel + 1. Reads only published-or-appended nodes and the cut: safe in parallel.
+void draftParent(const Hierarchy& hierarchy, const ObliqueCut& cut, const BuildOptions& options,
+                 int parentLevel, std::span<const CutRoot> group, WorklistResult& out) {
+    ParentDraft draft;
+    if (group.front().placeholder) {
+        // A placeholder's parent slot holds nothing else (the leaf it stands for had no other
+        // child), so its group is always itself alone.
+        assert(group.size() == 1);
+        const Placeholder& placeholder = cut.placeholder(group.front().index);
+        if (morton::level(placeholder.leafCode) != parentLevel) {
+            draft.risingPlaceholder = true;
+            draft.root = {group.front().code >> 3, group.front().index, true};
+            out.drafts.push_back(draft);
+            return;
+        }
+        OctreeNode& leaf = draft.node;
+        leaf.code = placeholder.leafCode;
+        leaf.coveredBegin = placeholder.coveredBegin;
+        leaf.coveredCount = placeholder.coveredCount;
+        leaf.flags = static_cast<std::uint8_t>(NodeFlag::Leaf) |
+                     static_cast<std::uint8_t>(NodeFlag::Collapsed);
+        leaf.pointCount = placeholder.coveredCount;
+        draft.substituted = true;
+        if (options.collapse == LeafCollapse::Paper) {
+            leaf.pointCount = sampleSize(placeholder.coveredCount, options.ratio);
+            draft.sampled = true;
+            draft.sampleOffset = static_cast<std::uint32_t>(out.samples.size());
+            out.samples.resize(out.samples.size() + leaf.pointCount);
+            sampleRange(placeholder.coveredBegin, placeholder.coveredCount,
+                        std::span(out.samples).subspan(draft.sampleOffset));
+            leaf.splatScale = static_cast<float>(
+                std::sqrt(static_cast<double>(placeholder.coveredCount) / leaf.pointCount));
+        }
+        out.drafts.push_back(draft);
+        return;
+    }
+
+    std::array<const OctreeNode*, 8> childNodes{};
+    assert(group.size() <= childNodes.size());
+    std::uint64_t childPoints = 0;
+    for (std::size_t c = 0; c < group.size(); ++c) {
+        // Siblings are adjacent in Morton order, hence adjacent in their level's array.
+        assert(!group[c].placeholder && group[c].index == group.front().index + c);
+        childNodes[c] = &hierarchy.node(parentLevel + 1, group[c].index);
+        childPoints += childNodes[c]->pointCount;
+    }
+    const std::span<const OctreeNode* const> children(childNodes.data(), group.size());
+    OctreeNode& parent = draft.node;
+    parent.code = group.front().code >> 3;
+    parent.firstChild = group.front().index;
+    parent.childCount = static_cast<std::uint8_t>(group.size());
+    parent.coveredBegin = children.front()->coveredBegin;
+    for (const OctreeNode* child : children) {
+        parent.coveredCount += child->coveredCount;
+    }
+    parent.pointCount = sampleSize(childPoints, options.ratio);
+    draft.sampled = true;
+    draft.sampleOffset = static_cast<std::uint32_t>(out.samples.size());
+    out.samples.resize(out.samples.size() + parent.pointCount);
+    sampleChildren(children, std::span(out.samples).subspan(draft.sampleOffset));
+    parent.splatScale = parentSplatScale(children, parent.pointCount);
+    out.drafts.push_back(draft);
+}
+
+} // namespace
+
+// The parallel machinery, kept out of the header: the task arena that bounds the threads,
+// per-thread scratch, and the buffers reused from pass to pass.
+class HierarchyBuilder::Worker {
+public:
+    explicit Worker(int threads) : arena(threads > 0 ? threads : tbb::task_arena::automatic) {}
+
+    tbb::task_arena arena;
+    tbb::enumerable_thread_specific<SplatScratch> splatScratch;
+    std::vector<WorklistResult> results;
+    WorklistResult merged;
+    std::vector<std::pair<const WorklistResult*, std::size_t>> order;
+    std::vector<LeafRun> runs;
+    std::vector<std::uint32_t> groupOf;  // run -> its sibling group
+    std::vector<std::size_t> groupFirst; // group -> its first run (+ one past the last)
+    std::vector<CutRoot> roots;
+};
+
+HierarchyBuilder::HierarchyBuilder(std::shared_ptr<const SortedCloud> cloud,
+                                   const BuildOptions& options)
+    : m_options((validate(options), options)), m_cloud(std::move(cloud)),
+      m_hierarchy(std::make_shared<Hierarchy>(m_cloud, options.maxLevel)), m_cut(options.maxLevel),
+      m_worker(std::make_unique<Worker>(options.threads)),
+      m_start(std::chrono::steady_clock::now()) {
+    m_stats.levels.resize(static_cast<std::size_t>(options.maxLevel) + 1);
+    m_stats.cloudBytes = sortedCloudBytes(*m_cloud);
+    m_publishedStats = m_stats;
+    m_thread = std::thread([this] { run(); });
+}
+
+HierarchyBuilder::~HierarchyBuilder() {
+    cancel();
+    if (m_thread.joinable()) {
+        m_thread.join();
+    }
+}
+
+void HierarchyBuilder::onSortedRange(const SortedCloud& cloud, std::size_t begin, std::size_t end) {
+    assert(&cloud == m_cloud.get() && end <= cloud.sortedEnd());
+    (void)cloud;
+    {
+        std::lock_guard lock(m_inputMutex);
+        assert(begin == m_available && !m_inputEnded);
+        (void)begin;
+        if (m_firstRangeSeconds < 0.0) {
+            m_firstRangeSeconds = secondsSinceStart();
+        }
+        m_available = end;
+        m_availableHint.store(end, std::memory_order_release);
+    }
+    m_inputChanged.notify_one();
+}
+
+SortedRangeConsumer HierarchyBuilder::consumer() {
+    return [this](const SortedCloud& cloud, std::size_t begin, std::size_t end) {
+        onSortedRange(cloud, begin, end);
+    };
+}
+
+void HierarchyBuilder::finish() {
+    {
+        std::lock_guard lock(m_inputMutex);
+        m_inputEnded = true;
+        m_inputEndSeconds = secondsSinceStart();
+    }
+    m_inputChanged.notify_one();
+}
+
+void HierarchyBuilder::cancel() {
+    {
+        std::lock_guard lock(m_inputMutex);
+        m_cancel.store(true, std::memory_order_relaxed);
+    }
+    m_inputChanged.notify_one();
+}
+
+void HierarchyBuilder::wait() {
+    std::unique_lock lock(m_doneMutex);
+    m_doneChanged.wait(lock, [this] { return m_done; });
+    if (m_error) {
+        std::rethrow_exception(m_error);
+    }
+}
+
+BuildStatistics HierarchyBuilder::statistics() const {
+    std::lock_guard lock(m_statsMutex);
+    return m_publishedStats;
+}
+
+double HierarchyBuilder::secondsSinceStart() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
+}
+
+void HierarchyBuilder::run() {
+    try {
+        m_worker->arena.execute([this] { buildLoop(); });
+    } catch (...) {
+        m_error = std::current_exception();
+    }
+    m_stats.creationSeconds = secondsSinceStart();
+    m_stats.cancelled = !m_stats.complete;
+    publishStatistics();
+    {
+        std::lock_guard lock(m_doneMutex);
+        m_done = true;
+    }
+    m_doneChanged.notify_all();
+}
+
+void HierarchyBuilder::buildLoop() {
+    bool passComplete = true;
+    for (;;) {
+        std::size_t available = 0;
+        bool inputEnded = false;
+        if (!waitForWork(passComplete, available, inputEnded)) {
+            return;
+        }
+        insertInput(available, inputEnded);
+        if (inputEnded && m_insertedEnd == available && !m_cut.closed()) {
+            m_cut.close();
+        }
+        passComplete = fixPass();
+        if (passComplete && m_cut.hasDelimiter()) {
+            m_hierarchy->publishCutDelimiter(m_cut.delimiter());
+        }
+        if (m_options.checkInvariants) {
+            checkInvariants(passComplete);
+        }
+        const bool complete = passComplete && m_cut.closed() && !cancelRequested();
+        if (complete) {
+            m_hierarchy->markComplete();
+            m_stats.complete = true;
+        }
+        publishStatistics();
+        if (complete || cancelRequested()) {
+            return;
+        }
+    }
+}
+
+// Blocks until there is something to do; false when cancelled.
+bool HierarchyBuilder::waitForWork(bool passComplete, std::size_t& available, bool& inputEnded) {
+    std::unique_lock lock(m_inputMutex);
+    if (passComplete && !m_inputBacklog) {
+        m_inputChanged.wait(lock, [this] {
+            return cancelRequested() || m_inputEnded || m_available != m_takenAvailable;
+        });
+    }
+    available = m_available;
+    inputEnded = m_inputEnded;
+    m_takenAvailable = available;
+    m_stats.firstRangeSeconds = m_firstRangeSeconds;
+    m_stats.inputEndSeconds = m_inputEndSeconds;
+    return !cancelRequested();
+}
+
+void HierarchyBuilder::insertInput(std::size_t available, bool inputEnded) {
+    const int maxLevel = m_options.maxLevel;
+    // Whole sibling groups only: leaf collapse must see a leaf's siblings, and a sparse leaf
+    // estimates its splats from its siblings' points.
+    const int groupShift = 3 * (morton::kMaxLevel - maxLevel) + 3;
+    const std::span<const morton::Code> codes = m_cloud->codes();
+    const std::size_t end =
+        insertableEnd(codes, m_insertedEnd, available, inputEnded, groupShift, kMaxInsertPoints);
+    m_inputBacklog =
+        insertableEnd(codes, end, available, inputEnded, groupShift, kMaxInsertPoints) > end;
+    if (end == m_insertedEnd) {
+        return;
+    }
+
+    Worker& worker = *m_worker;
+    std::vector<LeafRun>& runs = worker.runs;
+    runs.clear();
+    findLeafRuns(codes, m_insertedEnd, end, maxLevel, runs);
+    // Sibling groups: runs [groupFirst[g], groupFirst[g + 1]).
+    std::vector<std::uint32_t>& groupOf = worker.groupOf;
+    std::vector<std::size_t>& groupFirst = worker.groupFirst;
+    groupOf.resize(runs.size());
+    groupFirst.clear();
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+        if (i == 0 || (runs[i - 1].code >> 3) != (runs[i].code >> 3)) {
+            groupFirst.push_back(i);
+        }
+        groupOf[i] = static_cast<std::uint32_t>(groupFirst.size() - 1);
+    }
+    groupFirst.push_back(runs.size());
+    const auto groupSize = [&](std::size_t run) {
+        return groupFirst[groupOf[run] + 1] - groupFirst[groupOf[run]];
+    };
+    const bool collapse = m_options.collapse != LeafCollapse::Off;
+    const auto collapsed = [&](std::size_t run) {
+        return collapse && groupSize(run) == 1;
+    };
+
+    // Splat attributes: the heavy part of a leaf, one worklist of leaves per task.
+    const std::size_t worklistSize = m_options.worklistSize;
+    const std::size_t worklists = (runs.size() + worklistSize - 1) / worklistSize;
+    SplatAttributes& splats = m_hierarchy->mutableSplats();
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, worklists, 1),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+            SplatScratch& scratch = worker.splatScratch.local();
+            for (std::size_t w = range.begin(); w < range.end(); ++w) {
+                const std::size_t last = std::min(runs.size(), (w + 1) * worklistSize);
+                for (std::size_t i = w * worklistSize; i < last; ++i) {
+                    const LeafRun& first = runs[groupFirst[groupOf[i]]];
+                    const LeafRun& lastRun = runs[groupFirst[groupOf[i] + 1] - 1];
+                    splats.estimateLeaf(runs[i].begin, runs[i].begin + runs[i].count,
+                                        collapsed(i) ? maxLevel - 1 : maxLevel, first.begin,
+                                        lastRun.begin + lastRun.count, scratch);
+                }
+            }
+        },
+        tbb::simple_partitioner());
+    m_stats.worklists += worklists;
+
+    std::vector<CutRoot>& roots = worker.roots;
+    roots.clear();
+    LevelStatistics& leafLevel = m_stats.levels[maxLevel];
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+        const LeafRun& run = runs[i];
+        if (collapsed(i)) {
+            const morton::Code leafCode = run.code >> 3;
+            const std::uint32_t id = m_cut.addPlaceholder({leafCode, run.begin, run.count});
+            roots.push_back({morton::span(leafCode, maxLevel), id, true});
+            ++m_stats.placeholdersCreated;
+            ++m_stats.collapsedLeaves;
+            continue;
+        }
+        OctreeNode leaf;
+        leaf.code = run.code;
+        leaf.coveredBegin = run.begin;
+        leaf.coveredCount = run.count;
+        leaf.pointCount = run.count;
+        leaf.flags = static_cast<std::uint8_t>(NodeFlag::Leaf);
+        roots.push_back(
+            {run.code, static_cast<std::uint32_t>(m_hierarchy->appendNode(maxLevel, leaf)), false});
+        ++leafLevel.nodes;
+        ++leafLevel.leaves;
+        leafLevel.points += run.count;
+    }
+    m_hierarchy->publishNodes(maxLevel);
+    m_cut.concatenate(roots);
+    m_insertedEnd = end;
+    m_stats.inputPoints = end;
+    recordMilestones(m_stats.milestonesSeconds, end, m_cloud->capacity(), secondsSinceStart());
+}
+
+// One fix pass from maxLevel up; false when it stopped early (new input, or cancel).
+bool HierarchyBuilder::fixPass() {
+    ++m_stats.fixPasses;
+    for (int level = m_options.maxLevel; level >= 1; --level) {
+        fixLevel(level);
+        if (cancelRequested()) {
+            return false;
+        }
+        if (level > 1 && shouldStartNewPass(level - 1)) {
+            ++m_stats.passesRestarted;
+            return false;
+        }
+    }
+    return true;
+}
+
+void HierarchyBuilder::fixLevel(int level) {
+    Worker& worker = *m_worker;
+    const std::span<const CutRoot> pending = m_cut.pendingRoots(level);
+    const std::size_t worklistSize = m_options.worklistSize;
+    const std::size_t worklists = (pending.size() + worklistSize - 1) / worklistSize;
+    if (worker.results.size() < worklists) {
+        worker.results.resize(worklists);
+    }
+    const auto runWorklist = [&](std::size_t w) {
+        WorklistResult& result = worker.results[w];
+        result.clear();
+        const std::size_t first = w * worklistSize;
+        const auto slice = pending.subspan(first, std::min(worklistSize, pending.size() - first));
+        forEachSiblingGroup(slice, [&](std::span<const CutRoot> group) {
+            draftParent(*m_hierarchy, m_cut, m_options, level - 1, group, result);
+        });
+    };
+    if (worklists == 1) {
+        runWorklist(0);
+    } else if (worklists > 1) {
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(0, worklists, 1),
+            [&](const tbb::blocked_range<std::size_t>& range) {
+                for (std::size_t w = range.begin(); w < range.end(); ++w) {
+                    runWorklist(w);
+                }
+            },
+            tbb::simple_partitioner());
+    }
+    m_stats.worklists += worklists;
+
+    // Join the results in order. A sibling group cut by a worklist boundary gave the same
+    // parent twice, each with part of the children: rebuild it once from the whole group.
+    worker.merged.clear();
+    auto& order = worker.order;
+    order.clear();
+    for (std::size_t w = 0; w < worklists; ++w) {
+        const WorklistResult& result = worker.results[w];
+        for (std::size_t d = 0; d < result.drafts.size(); ++d) {
+            const morton::Code code = result.drafts[d].code();
+            if (order.empty() || order.back().first->drafts[order.back().second].code() != code) {
+                order.emplace_back(&result, d);
+                continue;
+            }
+            assert(d == 0); // groups are maximal within a worklist: only a boundary splits one
+            std::size_t groupBegin = w * worklistSize, groupEnd = w * worklistSize;
+            while (groupBegin > 0 && (pending[groupBegin - 1].code >> 3) == code) {
+                --groupBegin;
+            }
+            while (groupEnd < pending.size() && (pending[groupEnd].code >> 3) == code) {
+                ++groupEnd;
+            }
+            draftParent(*m_hierarchy, m_cut, m_options, level - 1,
+                        pending.subspan(groupBegin, groupEnd - groupBegin), worker.merged);
+            order.back() = {&worker.merged, worker.merged.drafts.size() - 1};
+            ++m_stats.duplicateParentsMerged;
+        }
+    }
+
+    // Commit in Morton order, then publish: no published node ever changes.
+    std::vector<CutRoot>& parents = worker.roots;
+    parents.clear();
+    LevelStatistics& parentLevel = m_stats.levels[level - 1];
+    for (const auto& [result, d] : order) {
+        const ParentDraft& draft = result->drafts[d];
+        if (draft.risingPlaceholder) {
+            parents.push_back(draft.root);
+            continue;
+        }
+        OctreeNode node = draft.node;
+        if (draft.sampled) {
+            std::uint32_t* samples = m_hierarchy->allocateSamples(node.pointCount);
+            std::copy_n(result->samples.begin() + draft.sampleOffset, node.pointCount, samples);
+            node.sampleIndices = samples;
+        }
+        parents.push_back({node.code,
+                           static_cast<std::uint32_t>(m_hierarchy->appendNode(level - 1, node)),
+                           false});
+        ++parentLevel.nodes;
+        parentLevel.points += node.pointCount;
+        if (draft.substituted) {
+            ++parentLevel.leaves;
+            ++m_stats.placeholdersSubstituted;
+            m_stats.droppedPoints += node.coveredCount - node.pointCount;
+        }
+    }
+    m_hierarchy->publishNodes(level - 1);
+    m_cut.completeLevel(level, parents);
+    m_hierarchy->publishFixedThrough(level, m_cut.delimiter());
+}
+
+// The paper's multipass decision: leave this pass for a new one from maxLevel when the new
+// input promises more work than the next level of this pass holds.
+bool HierarchyBuilder::shouldStartNewPass(int nextLevel) const {
+    if (m_cut.closed()) {
+        return false;
+    }
+    const std::size_t available = m_availableHint.load(std::memory_order_acquire);
+    if (available == m_takenAvailable && !m_inputBacklog) {
+        return false;
+    }
+    const std::uint64_t leaves = std::max<std::uint64_t>(
+        1, m_stats.levels[m_options.maxLevel].leaves + m_stats.collapsedLeaves);
+    const std::uint64_t pointsPerLeaf = std::max<std::uint64_t>(1, m_insertedEnd / leaves);
+    const std::uint64_t newLeaves = (available - m_insertedEnd) / pointsPerLeaf;
+    return newLeaves >= m_options.worklistSize && newLeaves > m_cut.pendingRoots(nextLevel).size();
+}
+
+void HierarchyBuilder::checkInvariants(bool completePass) {
+    if (!m_stats.invariantViolation.empty()) {
+        return;
+    }
+    CutCheckContext context;
+    context.ratio = m_options.ratio;
+    context.collapse = m_options.collapse;
+    context.insertedPoints = m_insertedEnd;
+    context.requireCompleteFix = completePass;
+    m_stats.invariantViolation = checkCutInvariants(m_cut, *m_hierarchy, context);
+#ifdef OMICRON_CHECK_INVARIANTS
+    if (!m_stats.invariantViolation.empty()) {
+        std::fprintf(stderr, "omicron: cut invariant violated: %s\n",
+                     m_stats.invariantViolation.c_str());
+        std::abort();
+    }
+#endif
+}
+
+void HierarchyBuilder::publishStatistics() {
+    m_stats.nodeBytes = m_hierarchy->nodeBytes();
+    m_stats.sampleBytes = m_hierarchy->sampleBytes();
+    m_stats.splatBytes = m_hierarchy->splatBytes();
+    std::lock_guard lock(m_statsMutex);
+    m_publishedStats = m_stats;
+}
+
+} // namespace omicron

@@ -1,0 +1,41 @@
+// Cutting the sorted stream into the leaves of a depth-maxLevel octree.
+//
+// A leaf is a run of points whose level-21 codes share the prefix codeAtLevel(code, maxLevel);
+// Morton order makes every such run contiguous. A range handed over by the sorter can end in
+// the middle of a run (or, for leaf collapse, of a sibling group), so the tail of the input
+// is held back until the next range or the end of input says where it stops.
+#pragma once
+
+#include "morton.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace omicron {
+
+struct LeafRun {
+    morton::Code code = 0; // at maxLevel
+    std::uint32_t begin = 0;
+    std::uint32_t count = 0;
+};
+
+// The end of the index range [begin, end) of codes that share codes[begin] >> shift
+// (exponential then binary search: O(log run length)).
+std::size_t endOfRun(std::span<const morton::Code> codes, std::size_t begin, std::size_t end,
+                     int shift);
+
+// Appends to `runs` the leaves at maxLevel of codes[begin, end).
+void findLeafRuns(std::span<const morton::Code> codes, std::size_t begin, std::size_t end,
+                  int maxLevel, std::vector<LeafRun>& runs);
+
+// How far [begin, available) may be cut into leaves now, taking at most about `limit` points:
+// the returned end never splits a group of codes sharing codes >> groupShift (a leaf, or a
+// sibling group when leaf collapse must see a leaf's siblings), unless `inputEnded`. Returns
+// `begin` when the only group in reach may still grow with later input.
+std::size_t insertableEnd(std::span<const morton::Code> codes, std::size_t begin,
+                          std::size_t available, bool inputEnded, int groupShift,
+                          std::size_t limit);
+
+} // namespace omicron

@@ -1,0 +1,41 @@
+// Storage for the point samples of parents: contiguous uint32 runs that never move.
+//
+// A bump allocator over large blocks. Nodes keep a raw pointer to their run, so a block is
+// never resized or freed while the store lives; the tail of a block that cannot fit the next
+// run is left unused (at most one run's worth per block).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace omicron {
+
+class SampleStore {
+public:
+    static constexpr std::size_t kBlockIndices = std::size_t{1} << 18; // 1 MiB blocks
+
+    // One writer thread. Returns space for `count` indices (count > 0).
+    std::uint32_t* allocate(std::size_t count) {
+        if (m_blocks.empty() || m_used + count > m_blockCapacity) {
+            m_blockCapacity = count > kBlockIndices ? count : kBlockIndices;
+            m_blocks.push_back(std::make_unique_for_overwrite<std::uint32_t[]>(m_blockCapacity));
+            m_bytesAllocated += m_blockCapacity * sizeof(std::uint32_t);
+            m_used = 0;
+        }
+        std::uint32_t* run = m_blocks.back().get() + m_used;
+        m_used += count;
+        return run;
+    }
+
+    std::size_t bytesAllocated() const { return m_bytesAllocated; }
+
+private:
+    std::vector<std::unique_ptr<std::uint32_t[]>> m_blocks;
+    std::size_t m_blockCapacity = 0;
+    std::size_t m_used = 0;
+    std::size_t m_bytesAllocated = 0;
+};
+
+} // namespace omicron

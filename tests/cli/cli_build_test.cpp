@@ -1,0 +1,103 @@
+// omicron-cli build --json on real scans: per-level node counts equal a brute-force octree of
+// the same depth, from unsorted input (pipeline 1) and from a .oms (pipeline 2) alike.
+#include "morton.hpp"
+#include "point_reader.hpp"
+#include "run_process.hpp"
+#include "test_files.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <regex>
+#include <set>
+
+namespace omicron {
+namespace {
+
+using test::runProcess;
+
+// "levels":[{"level":0,"nodes":N,...},...] -> the node and point counts, by level.
+std::vector<std::pair<std::uint64_t, std::uint64_t>> levelCounts(const std::string& json) {
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> counts;
+    const std::regex level(R"re(\{"level":(\d+),"nodes":(\d+),"leaves":\d+,"points":(\d+)\})re");
+    for (auto it = std::sregex_iterator(json.begin(), json.end(), level);
+         it != std::sregex_iterator(); ++it) {
+        EXPECT_EQ(std::stoull((*it)[1]), counts.size());
+        counts.emplace_back(std::stoull((*it)[2]), std::stoull((*it)[3]));
+    }
+    return counts;
+}
+
+// Nodes per level of the octree of depth `depth` over the file's points.
+std::vector<std::uint64_t> referenceNodes(const LoadedCloud& cloud, int depth) {
+    std::vector<std::set<morton::Code>> cells(depth + 1);
+    for (const glm::vec3& p : cloud.points.positions) {
+        const morton::Code code = morton::encodeUnit(p.x, p.y, p.z);
+        for (int level = 0; level <= depth; ++level) {
+            cells[level].insert(morton::codeAtLevel(code, level));
+        }
+    }
+    std::vector<std::uint64_t> nodes;
+    for (const auto& level : cells) {
+        nodes.push_back(level.size());
+    }
+    return nodes;
+}
+
+class CliBuildSharedData : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(CliBuildSharedData, LevelsMatchABruteForceOctree) {
+    OMICRON_REQUIRE_SHARED_FILE(path, GetParam());
+    const int depth = 6;
+    const LoadedCloud cloud = loadPointCloud(path);
+    const std::vector<std::uint64_t> expected = referenceNodes(cloud, depth);
+
+    test::TempDir dir;
+    const std::string oms = dir.file("sorted.oms");
+    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"sort", path, oms}).exitCode, 0);
+    for (const std::string& input : {path, oms}) {
+        const auto result = runProcess(OMICRON_CLI_PATH,
+                                       {"build", input, "--depth", std::to_string(depth), "--json"});
+        ASSERT_EQ(result.exitCode, 0) << result.err;
+        EXPECT_NE(result.out.find("\"points_in\":" + std::to_string(cloud.points.size())),
+                  std::string::npos)
+            << result.out;
+        EXPECT_NE(result.out.find("\"complete\":true"), std::string::npos) << result.out;
+        const auto levels = levelCounts(result.out);
+        ASSERT_EQ(levels.size(), expected.size()) << result.out;
+        for (int level = 0; level <= depth; ++level) {
+            EXPECT_EQ(levels[level].first, expected[level]) << input << " level " << level;
+        }
+        // Collapse off: the deepest level's leaves hold every input point.
+        EXPECT_EQ(levels[depth].second, cloud.points.size());
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Files, CliBuildSharedData,
+                         ::testing::Values("bunny.ply", "autzen_trim.las", "lion.ply",
+                                           "sorvilier.ply", "indoor.ply", "dragon.ply"),
+                         [](const auto& info) {
+                             std::string name = info.param;
+                             std::replace(name.begin(), name.end(), '.', '_');
+                             return name;
+                         });
+
+TEST(CliBuild, PaperCollapseCountsDroppedPointsAndBadOptionsExitTwo) {
+    OMICRON_REQUIRE_SHARED_FILE(path, "bunny.ply");
+    const auto paper = runProcess(OMICRON_CLI_PATH, {"build", path, "--collapse", "paper",
+                                                     "--depth", "8", "--json"});
+    ASSERT_EQ(paper.exitCode, 0) << paper.err;
+    const std::smatch match = [&] {
+        std::smatch m;
+        std::regex_search(paper.out, m, std::regex(R"("dropped_points":(\d+))"));
+        return m;
+    }();
+    ASSERT_EQ(match.size(), 2u) << paper.out;
+    EXPECT_GT(std::stoull(match[1]), 0u) << "paper collapse on the bunny drops chain leaves";
+    EXPECT_EQ(runProcess(OMICRON_CLI_PATH, {"build", path, "--collapse", "maybe"}).exitCode, 2);
+    EXPECT_EQ(runProcess(OMICRON_CLI_PATH, {"build", path, "--depth", "22"}).exitCode, 2);
+    EXPECT_EQ(runProcess(OMICRON_CLI_PATH, {"build", path, "--ratio", "1.5"}).exitCode, 2);
+}
+
+} // namespace
+} // namespace omicron

@@ -1,0 +1,97 @@
+// Cutting sorted codes into leaves, and how much of a growing prefix may be cut now.
+#include "leaf_runs.hpp"
+
+#include <gtest/gtest.h>
+#include <random>
+#include <vector>
+
+namespace omicron {
+namespace {
+
+// Level-21 codes whose level-`level` prefixes are the given cells' codes, sorted.
+std::vector<morton::Code> codesWithRuns(const std::vector<std::size_t>& runLengths, int level) {
+    std::vector<morton::Code> codes;
+    morton::Code cell = morton::encode({0, 0, 0}, level);
+    const int shift = 3 * (morton::kMaxLevel - level);
+    for (std::size_t length : runLengths) {
+        for (std::size_t i = 0; i < length; ++i) {
+            codes.push_back((cell << shift) | (i % (morton::Code{1} << shift)));
+        }
+        std::sort(codes.end() - static_cast<std::ptrdiff_t>(length), codes.end());
+        cell += 3; // skips cells: runs are not always siblings
+    }
+    return codes;
+}
+
+TEST(LeafRuns, EndOfRunMatchesALinearScanForEveryRunLength) {
+    std::vector<std::size_t> lengths;
+    for (std::size_t length = 1; length <= 70; ++length) {
+        lengths.push_back(length);
+    }
+    lengths.push_back(1000);
+    lengths.push_back(1);
+    const int level = 5;
+    const auto codes = codesWithRuns(lengths, level);
+    const int shift = 3 * (morton::kMaxLevel - level);
+    std::size_t begin = 0;
+    for (std::size_t length : lengths) {
+        EXPECT_EQ(endOfRun(codes, begin, codes.size(), shift), begin + length);
+        // A range that ends inside the run stops there.
+        EXPECT_EQ(endOfRun(codes, begin, begin + (length + 1) / 2, shift),
+                  begin + (length + 1) / 2);
+        begin += length;
+    }
+}
+
+TEST(LeafRuns, FindLeafRunsCoversTheRangeWithOneRunPerCell) {
+    const std::vector<std::size_t> lengths = {3, 1, 1, 17, 256, 2};
+    const int level = 4;
+    const auto codes = codesWithRuns(lengths, level);
+    std::vector<LeafRun> runs;
+    findLeafRuns(codes, 0, codes.size(), level, runs);
+    ASSERT_EQ(runs.size(), lengths.size());
+    std::uint32_t begin = 0;
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+        EXPECT_EQ(runs[r].begin, begin);
+        EXPECT_EQ(runs[r].count, lengths[r]);
+        EXPECT_EQ(runs[r].code, morton::codeAtLevel(codes[begin], level));
+        begin += runs[r].count;
+    }
+}
+
+TEST(LeafRuns, InsertableEndHoldsBackTheRunThatMayContinue) {
+    const int level = 3;
+    const int shift = 3 * (morton::kMaxLevel - level);
+    const auto codes = codesWithRuns({4, 5, 6}, level);
+    // Input so far ends inside the third run: it is held back.
+    EXPECT_EQ(insertableEnd(codes, 0, 12, false, shift, 1000), 9u);
+    // Input ended: everything goes.
+    EXPECT_EQ(insertableEnd(codes, 0, 12, true, shift, 1000), 12u);
+    // The per-pass limit cuts before the run it lands in.
+    EXPECT_EQ(insertableEnd(codes, 0, 15, false, shift, 6), 4u);
+    // A single run longer than the limit is taken whole once its end is known...
+    EXPECT_EQ(insertableEnd(codes, 4, 15, false, shift, 2), 9u);
+    // ...and waited for while it may still grow.
+    EXPECT_EQ(insertableEnd(codes, 9, 15, false, shift, 2), 9u);
+    EXPECT_EQ(insertableEnd(codes, 9, 15, true, shift, 2), 15u);
+    EXPECT_EQ(insertableEnd(codes, 15, 15, true, shift, 2), 15u);
+}
+
+TEST(LeafRuns, InsertableEndWithASiblingGroupShiftKeepsSiblingsTogether) {
+    const int level = 3;
+    const int groupShift = 3 * (morton::kMaxLevel - level) + 3;
+    // Two sibling leaves (cells 0 and 1 of one parent), then a leaf of another parent.
+    std::vector<morton::Code> codes;
+    const int leafShift = 3 * (morton::kMaxLevel - level);
+    for (morton::Code cell :
+         {morton::Code{0b1000000000}, morton::Code{0b1000000001}, morton::Code{0b1000001000}}) {
+        codes.push_back(cell << leafShift);
+        codes.push_back((cell << leafShift) | 5);
+    }
+    EXPECT_EQ(insertableEnd(codes, 0, 3, false, groupShift, 100), 0u);
+    EXPECT_EQ(insertableEnd(codes, 0, 5, false, groupShift, 100), 4u);
+    EXPECT_EQ(insertableEnd(codes, 0, 6, true, groupShift, 100), 6u);
+}
+
+} // namespace
+} // namespace omicron

@@ -1,0 +1,83 @@
+// The parents' samples: size, distinctness, order, spread, and the splat scale.
+#include "parent_sampler.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <gtest/gtest.h>
+#include <vector>
+
+namespace omicron {
+namespace {
+
+TEST(ParentSampler, SampleSizeIsTheRoundedRatioAndAtLeastOne) {
+    EXPECT_EQ(sampleSize(10, 0.2), 2u);
+    EXPECT_EQ(sampleSize(12, 0.2), 2u); // 2.4
+    EXPECT_EQ(sampleSize(13, 0.2), 3u); // 2.6
+    EXPECT_EQ(sampleSize(2, 0.2), 1u);  // 0.4, but a parent keeps one point
+    EXPECT_EQ(sampleSize(1, 0.2), 1u);
+    EXPECT_EQ(sampleSize(7, 1.0), 7u);
+    EXPECT_EQ(sampleSize(4000000000ull, 0.25), 1000000000u);
+}
+
+TEST(ParentSampler, RangeSampleIsEvenlySpacedAndDistinct) {
+    std::vector<std::uint32_t> out(4);
+    sampleRange(100, 8, out);
+    EXPECT_EQ(out, (std::vector<std::uint32_t>{101, 103, 105, 107}));
+    out.assign(1, 0);
+    sampleRange(0, 9, out);
+    EXPECT_EQ(out.front(), 4u) << "a single pick is the middle point";
+    out.assign(9, 0);
+    sampleRange(50, 9, out);
+    EXPECT_EQ(out, (std::vector<std::uint32_t>{50, 51, 52, 53, 54, 55, 56, 57, 58}));
+}
+
+TEST(ParentSampler, ChildrenSampleDrawsFromEveryChildInProportion) {
+    // Child 0 holds a range, child 1 a sample list, child 2 a range.
+    const std::vector<std::uint32_t> childSample = {1000, 1003, 1010, 1011, 1020,
+                                                    1021, 1030, 1031, 1040, 1041};
+    std::array<OctreeNode, 3> nodes{};
+    nodes[0].coveredBegin = 0;
+    nodes[0].pointCount = 20;
+    nodes[1].sampleIndices = childSample.data();
+    nodes[1].pointCount = static_cast<std::uint32_t>(childSample.size());
+    nodes[2].coveredBegin = 5000;
+    nodes[2].pointCount = 10;
+    const std::array<const OctreeNode*, 3> children = {&nodes[0], &nodes[1], &nodes[2]};
+    std::vector<std::uint32_t> out(sampleSize(40, 0.25));
+    ASSERT_EQ(out.size(), 10u);
+    sampleChildren(children, out);
+    EXPECT_TRUE(std::is_sorted(out.begin(), out.end()));
+    EXPECT_EQ(std::adjacent_find(out.begin(), out.end()), out.end()) << "no duplicates";
+    const auto from = [&](std::uint32_t lo, std::uint32_t hi) {
+        return std::count_if(out.begin(), out.end(),
+                             [&](std::uint32_t i) { return i >= lo && i < hi; });
+    };
+    EXPECT_EQ(from(0, 20), 5);
+    EXPECT_EQ(from(1000, 1100), 2);
+    EXPECT_EQ(from(5000, 5010), 3);
+    for (std::uint32_t index : out) {
+        if (index >= 1000 && index < 1100) {
+            EXPECT_NE(std::find(childSample.begin(), childSample.end(), index), childSample.end());
+        }
+    }
+    // Taking all points returns the concatenation itself.
+    std::vector<std::uint32_t> all(40);
+    sampleChildren(children, all);
+    EXPECT_EQ(all[20], 1000u);
+    EXPECT_EQ(all[39], 5009u);
+}
+
+TEST(ParentSampler, SplatScaleKeepsTheCoveredArea) {
+    std::array<OctreeNode, 2> nodes{};
+    nodes[0].pointCount = 30;
+    nodes[0].splatScale = 1.0f;
+    nodes[1].pointCount = 10;
+    nodes[1].splatScale = 2.0f;
+    const std::array<const OctreeNode*, 2> children = {&nodes[0], &nodes[1]};
+    // (30 x 1 + 10 x 4) / 7 = 10.
+    EXPECT_FLOAT_EQ(parentSplatScale(children, 7), std::sqrt(10.0f));
+}
+
+} // namespace
+} // namespace omicron
