@@ -17,7 +17,7 @@ constexpr double kPi = 3.14159265358979323846;
 // stations fill the far field a little).
 constexpr double kFullDensityRange = 15.0;
 constexpr double kFarDensity = 0.15;
-constexpr double kTerrainNearRange = 1.5; // the scanner's own blind spot
+constexpr double kTerrainNearRange = 1.5;     // the scanner's own blind spot
 constexpr double kTerrainRangeFraction = 0.7; // terrain points drawn by range, the rest by area
 
 // The statue: a (2, 3) torus knot standing on a pedestal, turned towards the scanner.
@@ -32,7 +32,9 @@ double smoothstep(double edge0, double edge1, double x) {
     return t * t * (3.0 - 2.0 * t);
 }
 
-glm::dvec3 rgb(glm::u8vec3 color) { return glm::dvec3(color); }
+glm::dvec3 rgb(glm::u8vec3 color) {
+    return glm::dvec3(color);
+}
 
 // Rounds to 8 bits after a little per-point variation, as a camera-coloured scan has.
 glm::u8vec3 toColor(const glm::dvec3& color, SceneRandom& random, double jitter) {
@@ -149,8 +151,8 @@ void SceneLayout::addBuilding(glm::dvec2 centre, glm::dvec2 halfSize, double ang
         patch.floorLevel = floorLevel;
         patch.height = wallHeight;
         patch.color = color;
-        patch.area = glm::length(glm::cross(edgeU, edgeV)) *
-                     (shape == Patch::Shape::Triangle ? 0.5 : 1.0);
+        patch.area =
+            glm::length(glm::cross(edgeU, edgeV)) * (shape == Patch::Shape::Triangle ? 0.5 : 1.0);
         m_buildings.add(patch);
     };
     const glm::dvec3 up(0.0, 0.0, 1.0);
@@ -168,8 +170,8 @@ void SceneLayout::addBuilding(glm::dvec2 centre, glm::dvec2 halfSize, double ang
     addFlat(Shape::Parallelogram, Style::Wall, world(-hx, -hy, base), 2 * hx * x3, wallUp, -y3,
             wallColor);
     if (!gableRoof) {
-        addFlat(Shape::Parallelogram, Style::Roof, world(-hx, -hy, top), 2 * hx * x3,
-                2 * hy * y3, up, roofColor);
+        addFlat(Shape::Parallelogram, Style::Roof, world(-hx, -hy, top), 2 * hx * x3, 2 * hy * y3,
+                up, roofColor);
         return;
     }
     // Ridge along the local x axis, eaves overhanging the walls.
@@ -179,8 +181,9 @@ void SceneLayout::addBuilding(glm::dvec2 centre, glm::dvec2 halfSize, double ang
     const double run = hy + overhang;
     const glm::dvec3 along = 2 * (hx + overhang) * x3;
     for (const double side : {-1.0, 1.0}) {
-        addFlat(Shape::Parallelogram, Style::Roof, world(-hx - overhang, side * run, top - eaveDrop),
-                along, -side * run * y3 + (rise + eaveDrop) * up, up, roofColor);
+        addFlat(Shape::Parallelogram, Style::Roof,
+                world(-hx - overhang, side * run, top - eaveDrop), along,
+                -side * run * y3 + (rise + eaveDrop) * up, up, roofColor);
         addFlat(Shape::Triangle, Style::Wall, world(side * hx, -hy, top), 2 * hy * y3,
                 hy * y3 + rise * up, side * x3, wallColor);
     }
@@ -197,8 +200,7 @@ void SceneLayout::addStatue() {
         return glm::dvec3(kStatueCentre.x + sx * half, kStatueCentre.y + sy * half, z);
     };
     const glm::dvec3 wallUp(0.0, 0.0, top - base);
-    const auto add = [&](glm::dvec3 origin, glm::dvec3 edgeU, glm::dvec3 edgeV,
-                         glm::dvec3 normal) {
+    const auto add = [&](glm::dvec3 origin, glm::dvec3 edgeU, glm::dvec3 edgeV, glm::dvec3 normal) {
         Patch patch;
         patch.style = Patch::Style::Stone;
         patch.origin = origin;
@@ -234,7 +236,7 @@ void SceneLayout::addStatue() {
     knot.style = Patch::Style::Bronze;
     // Resting on the pedestal, the lowest loop half sunk into it.
     knot.origin = glm::dvec3(kStatueCentre, top - lowest * kKnotScale + 0.5 * kKnotTube);
-    knot.edgeV = glm::dvec3(towardScanner, 0.0);                      // the knot's thin axis
+    knot.edgeV = glm::dvec3(towardScanner, 0.0);                     // the knot's thin axis
     knot.edgeU = glm::dvec3(towardScanner.y, -towardScanner.x, 0.0); // across, horizontal
     knot.radius = kKnotTube;
     knot.color = {150, 100, 50};
@@ -309,10 +311,14 @@ double SceneLayout::keepProbability(const glm::dvec3& p) const {
 
 ScenePoint SceneLayout::sample(SceneComponent component, SceneRandom& random) const {
     switch (component) {
-    case SceneComponent::Terrain: return sampleTerrain(random);
-    case SceneComponent::Buildings: return sampleSurface(m_buildings, random);
-    case SceneComponent::Trees: return sampleSurface(m_trees, random);
-    case SceneComponent::Statue: return sampleSurface(m_statue, random);
+    case SceneComponent::Terrain:
+        return sampleTerrain(random);
+    case SceneComponent::Buildings:
+        return sampleSurface(m_buildings, random);
+    case SceneComponent::Trees:
+        return sampleSurface(m_trees, random);
+    case SceneComponent::Statue:
+        return sampleSurface(m_statue, random);
     }
     return sampleTerrain(random);
 }
@@ -324,7 +330,8 @@ ScenePoint SceneLayout::sampleTerrain(SceneRandom& random) const {
         if (random.uniform() < kTerrainRangeFraction) {
             // Log-uniform range: the density falls with the square of the range.
             const double range =
-                kTerrainNearRange * std::exp(random.uniform() * std::log(farRange / kTerrainNearRange));
+                kTerrainNearRange *
+                std::exp(random.uniform() * std::log(farRange / kTerrainNearRange));
             const double angle = random.uniform(0.0, 2.0 * kPi);
             p = glm::dvec2(m_scanner) + range * glm::dvec2(std::cos(angle), std::sin(angle));
         } else {
@@ -353,8 +360,7 @@ ScenePoint SceneLayout::sampleTerrain(SceneRandom& random) const {
                 std::sin(0.061 * p.y + 1.3 * std::sin(0.033 * p.x)) +
             0.35 * std::sin(0.13 * p.x + 0.09 * p.y + 2.0 * std::sin(0.05 * p.y));
         color = glm::mix(color, glm::dvec3(125, 100, 70), smoothstep(0.55, 0.85, soilPattern));
-        color = glm::mix(color, glm::dvec3(135, 130, 120),
-                         smoothstep(0.97, 0.93, point.normal.z));
+        color = glm::mix(color, glm::dvec3(135, 130, 120), smoothstep(0.97, 0.93, point.normal.z));
         if (onRoad(p)) {
             color = glm::dvec3(85, 85, 90);
         }
@@ -438,7 +444,8 @@ ScenePoint SceneLayout::samplePatch(const Patch& patch, SceneRandom& random) con
         const bool window = level > 0.0 && level < patch.height - 0.5 && storey > 0.9 &&
                             storey < 2.1 && column > 0.8 && column < 1.9 && along > 1.0 &&
                             along < glm::length(patch.edgeU) - 1.0;
-        color = window ? glm::dvec3(55, 65, 80) : color * (0.85 + 0.15 * std::min(1.0, level / 1.5));
+        color =
+            window ? glm::dvec3(55, 65, 80) : color * (0.85 + 0.15 * std::min(1.0, level / 1.5));
         jitter = window ? 5.0 : 10.0;
     } else if (patch.style == Patch::Style::Roof) {
         const double slope = t * glm::length(patch.edgeV);

@@ -213,13 +213,17 @@ bool isSupportedColumnCount(std::size_t columns) {
 
 ColumnLayout layoutFor(std::size_t columns, bool sixColumnsHoldColors) {
     switch (columns) {
-    case 3: return {3, -1, -1, -1, "x y z"};
-    case 4: return {4, 3, -1, -1, "x y z intensity"};
+    case 3:
+        return {3, -1, -1, -1, "x y z"};
+    case 4:
+        return {4, 3, -1, -1, "x y z intensity"};
     case 6:
         return sixColumnsHoldColors ? ColumnLayout{6, -1, 3, -1, "x y z r g b"}
                                     : ColumnLayout{6, -1, -1, 3, "x y z nx ny nz"};
-    case 7: return {7, 3, 4, -1, "x y z intensity r g b"};
-    default: return {9, -1, 3, 6, "x y z r g b nx ny nz"};
+    case 7:
+        return {7, 3, 4, -1, "x y z intensity r g b"};
+    default:
+        return {9, -1, 3, 6, "x y z r g b nx ny nz"};
     }
 }
 
@@ -248,8 +252,8 @@ void checkRow(const Row& row, std::size_t expectedColumns, std::uint64_t firstDa
     }
     if (row.badColumn != 0) {
         throw InputError(InputErrorKind::MalformedValue, path, InputLocation::line(lineNumber),
-                         "column " + std::to_string(row.badColumn) +
-                             ": expected a number, found " + quoted(row.badText));
+                         "column " + std::to_string(row.badColumn) + ": expected a number, found " +
+                             quoted(row.badText));
     }
 }
 
@@ -257,8 +261,7 @@ void checkColors(const Row& row, int colorColumn, const std::string& path,
                  std::uint64_t lineNumber) {
     for (int c = colorColumn; c < colorColumn + 3; ++c) {
         if (!isColorValue(row.values[c])) {
-            throw InputError(InputErrorKind::MalformedValue, path,
-                             InputLocation::line(lineNumber),
+            throw InputError(InputErrorKind::MalformedValue, path, InputLocation::line(lineNumber),
                              "column " + std::to_string(c + 1) +
                                  ": expected a colour value, an integer 0..255, found " +
                                  quoted(row.texts[c]));
@@ -267,13 +270,14 @@ void checkColors(const Row& row, int colorColumn, const std::string& path,
 }
 
 [[noreturn]] void throwBadIntensity(const std::string& path, std::uint64_t lineNumber, int column,
-                       double value) {
+                                    double value) {
     char text[64];
     std::snprintf(text, sizeof text, "%.9g", value);
     throw InputError(InputErrorKind::MalformedValue, path, InputLocation::line(lineNumber),
                      "column " + std::to_string(column + 1) +
                          ": expected an intensity in 0..65535 (or -2048..2047 throughout, as "
-                         "Leica PTS writes them), found " + text);
+                         "Leica PTS writes them), found " +
+                         text);
 }
 
 // Where the data starts, and what the whole file holds: the result of the pre-pass.
@@ -325,11 +329,10 @@ void findFirstDataLine(LineReader& lines, Row& row, XyzScan& scan, const std::st
             return;
         }
         if (++scan.headerLines > kMaxHeaderLines) {
-            throw InputError(InputErrorKind::MalformedValue, path,
-                             InputLocation::line(lines.lineNumber()),
-                             "expected a line of numbers (x y z ...) within the first " +
-                                 std::to_string(kMaxHeaderLines) +
-                                 " non-comment lines, found " + quoted(line));
+            throw InputError(
+                InputErrorKind::MalformedValue, path, InputLocation::line(lines.lineNumber()),
+                "expected a line of numbers (x y z ...) within the first " +
+                    std::to_string(kMaxHeaderLines) + " non-comment lines, found " + quoted(line));
         }
     }
     throw InputError(InputErrorKind::NoPoints, path, InputLocation::none(),
@@ -504,8 +507,8 @@ private:
         }
         batch.positions.push_back(normalizer.toUnit(source));
         if (m_layout.intensity >= 0) {
-            batch.intensities.push_back(toIntensity(row.values[m_layout.intensity],
-                                                    m_intensityScale));
+            batch.intensities.push_back(
+                toIntensity(row.values[m_layout.intensity], m_intensityScale));
         }
         if (m_layout.color >= 0) {
             checkColors(row, m_layout.color, m_info.path, lineNumber);
