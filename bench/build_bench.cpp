@@ -1,0 +1,159 @@
+// Hierarchy build cost against baselines measured in the same run, and the paper's tables.
+//
+// usage: build_bench FILE [--depth D]   (e.g. ../shared/data/autzen_south.ply, depth 7)
+// (a) build from an in-memory sorted stream vs parsing the same file vs one memcpy of the
+//     points; (b) worklist size 8..128 -> creation time, nodes, resident bytes; (c) leaf
+//     collapse off/lossless/paper x ratio 0.2/0.25 -> resident bytes (and vs the file size),
+//     creation time; (d) 1 vs 2 threads. Each figure is the best of 3 runs.
+#include "hierarchy_builder.hpp"
+#include "morton_sorter.hpp"
+#include "point_reader.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+template <typename Fn> double bestSeconds(int runs, Fn&& fn) {
+    double best = 1e30;
+    for (int i = 0; i < runs; ++i) {
+        const auto start = Clock::now();
+        fn();
+        best = std::min(best, secondsSince(start));
+    }
+    return best;
+}
+
+struct BuildResult {
+    double seconds = 1e30;
+    omicron::BuildStatistics stats;
+};
+
+// Builds from the complete sorted cloud handed over as one range; best of `runs`.
+BuildResult buildBest(const std::shared_ptr<const omicron::SortedCloud>& cloud,
+                      const omicron::BuildOptions& options, int runs = 3) {
+    BuildResult best;
+    for (int i = 0; i < runs; ++i) {
+        const auto start = Clock::now();
+        omicron::HierarchyBuilder builder(cloud, options);
+        builder.onSortedRange(*cloud, 0, cloud->sortedEnd());
+        builder.finish();
+        builder.wait();
+        const double seconds = secondsSince(start);
+        if (seconds < best.seconds) {
+            best = {seconds, builder.statistics()};
+        }
+    }
+    return best;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2) {
+        std::fprintf(stderr, "usage: build_bench FILE [--depth D]\n");
+        return 2;
+    }
+    const std::string path = argv[1];
+    int depth = 7;
+    if (argc > 3 && std::strcmp(argv[2], "--depth") == 0) {
+        depth = std::atoi(argv[3]);
+    }
+    try {
+        const double fileBytes = static_cast<double>(std::filesystem::file_size(path));
+        std::shared_ptr<const omicron::SortedCloud> cloud;
+        {
+            auto reader = omicron::openPointCloud(path);
+            omicron::sortPointCloud(
+                *reader, {}, [](const omicron::SortedCloud&, std::size_t, std::size_t) {},
+                [&](const omicron::IncrementalMortonSorter& sorter) { cloud = sorter.cloud(); });
+        }
+        const std::size_t points = cloud->sortedEnd();
+
+        // (a) baselines: parse the same file (bounds known), one memcpy of the points.
+        omicron::OpenOptions known;
+        known.knownBounds = omicron::openPointCloud(path)->info().sourceBounds;
+        const double parseS = bestSeconds(3, [&] {
+            omicron::openPointCloud(path, known)->read([](const omicron::PointBatch&) {});
+        });
+        std::vector<glm::vec3> copy(points);
+        const double memcpyS = bestSeconds(3, [&] {
+            std::memcpy(copy.data(), cloud->positions().data(), points * sizeof(glm::vec3));
+        });
+        omicron::BuildOptions base;
+        base.maxLevel = depth;
+        const BuildResult build = buildBest(cloud, base);
+        std::printf("bench=build_vs_baselines points=%zu depth=%d build_ms=%.1f parse_ms=%.1f "
+                    "memcpy_ms=%.2f build_vs_parse=%.2f build_mpoints_per_s=%.1f nodes=%llu\n",
+                    points, depth, build.seconds * 1e3, parseS * 1e3, memcpyS * 1e3,
+                    build.seconds / parseS, points / build.seconds / 1e6,
+                    static_cast<unsigned long long>(build.stats.totalNodes()));
+        std::fflush(stdout);
+
+        // (b) worklist sizes.
+        for (std::size_t worklist : {8, 16, 32, 64, 128}) {
+            omicron::BuildOptions options = base;
+            options.worklistSize = worklist;
+            const BuildResult r = buildBest(cloud, options);
+            std::printf("bench=build_worklist worklist=%zu creation_ms=%.1f nodes=%llu "
+                        "worklists=%llu duplicate_parents_merged=%llu bytes_resident=%zu\n",
+                        worklist, r.seconds * 1e3,
+                        static_cast<unsigned long long>(r.stats.totalNodes()),
+                        static_cast<unsigned long long>(r.stats.worklists),
+                        static_cast<unsigned long long>(r.stats.duplicateParentsMerged),
+                        r.stats.bytesResident());
+            std::fflush(stdout);
+        }
+
+        // (c) leaf collapse x ratio.
+        for (omicron::LeafCollapse collapse :
+             {omicron::LeafCollapse::Off, omicron::LeafCollapse::Lossless,
+              omicron::LeafCollapse::Paper}) {
+            for (double ratio : {0.2, 0.25}) {
+                omicron::BuildOptions options = base;
+                options.collapse = collapse;
+                options.ratio = ratio;
+                const BuildResult r = buildBest(cloud, options);
+                std::printf("bench=build_collapse collapse=%s ratio=%.2f creation_ms=%.1f "
+                            "bytes_resident=%zu bytes_per_point=%.1f vs_file_size=%.2f "
+                            "hierarchy_bytes=%zu dropped_points=%llu\n",
+                            omicron::toString(collapse), ratio, r.seconds * 1e3,
+                            r.stats.bytesResident(),
+                            double(r.stats.bytesResident()) / double(points),
+                            double(r.stats.bytesResident()) / fileBytes,
+                            r.stats.bytesResident() - r.stats.cloudBytes,
+                            static_cast<unsigned long long>(r.stats.droppedPoints));
+                std::fflush(stdout);
+            }
+        }
+
+        // (d) threads.
+        double oneThreadS = 0.0;
+        for (int threads : {1, 2}) {
+            omicron::BuildOptions options = base;
+            options.threads = threads;
+            const BuildResult r = buildBest(cloud, options);
+            if (threads == 1) {
+                oneThreadS = r.seconds;
+            }
+            std::printf("bench=build_threads threads=%d creation_ms=%.1f speedup=%.2f\n", threads,
+                        r.seconds * 1e3, oneThreadS / r.seconds);
+            std::fflush(stdout);
+        }
+    } catch (const std::exception& error) {
+        std::fprintf(stderr, "build_bench: %s\n", error.what());
+        return 1;
+    }
+    return 0;
+}
