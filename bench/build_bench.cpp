@@ -5,6 +5,7 @@
 //     points; (b) worklist size 8..128 -> creation time, nodes, resident bytes; (c) leaf
 //     collapse off/lossless/paper x ratio 0.2/0.25 -> resident bytes (and vs the file size),
 //     creation time; (d) 1 vs 2 threads. Each figure is the best of 3 runs.
+#include "bench_timing.hpp"
 #include "hierarchy_builder.hpp"
 #include "morton_sorter.hpp"
 #include "point_reader.hpp"
@@ -19,21 +20,9 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-template <typename Fn> double bestSeconds(int runs, Fn&& fn) {
-    double best = 1e30;
-    for (int i = 0; i < runs; ++i) {
-        const auto start = Clock::now();
-        fn();
-        best = std::min(best, secondsSince(start));
-    }
-    return best;
-}
+using omicron::bench::bestSeconds;
+using omicron::bench::Clock;
+using omicron::bench::secondsSince;
 
 struct BuildResult {
     double seconds = 1e30;

@@ -3,6 +3,7 @@
 // the same run. Prints one machine-readable line per variant.
 //
 // usage: morton_bench [POINTS]   (default 20,000,000)
+#include "bench_timing.hpp"
 #include "morton.hpp"
 
 #include <array>
@@ -55,19 +56,8 @@ struct PackedRecord { // what a compact AoS layout of our attributes would be
     std::uint16_t intensity;
 };
 
-template <typename Fn> double seconds(Fn&& fn) {
-    const auto start = std::chrono::steady_clock::now();
-    fn();
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 template <typename Fn> double bestOf3(Fn&& fn) {
-    double best = 1e30;
-    for (int i = 0; i < 3; ++i) {
-        const double s = seconds(fn);
-        best = s < best ? s : best;
-    }
-    return best;
+    return omicron::bench::bestSeconds(3, fn);
 }
 
 void printLine(const char* variant, const char* layout, std::size_t points, double s,

@@ -9,6 +9,7 @@
 //   mb_per_s=... raw_mb_per_s=... ratio_vs_raw=...
 // phase=open_and_read includes the bounds pre-pass of formats whose header has no bounds;
 // phase=parse passes the bounds in (OpenOptions::knownBounds), so it is the streaming parse.
+#include "bench_timing.hpp"
 #include "las_writer.hpp"
 #include "ply_writer.hpp"
 #include "point_reader.hpp"
@@ -25,23 +26,7 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-// Best of `runs` timings of fn(); fn returns the number of points it saw.
-template <typename Fn> double bestSeconds(int runs, Fn&& fn) {
-    double best = 1e30;
-    for (int i = 0; i < runs; ++i) {
-        const auto start = Clock::now();
-        fn();
-        const double s = secondsSince(start);
-        best = s < best ? s : best;
-    }
-    return best;
-}
+using omicron::bench::bestSeconds;
 
 std::uint64_t rawRead(const std::string& path) {
     const int fd = ::open(path.c_str(), O_RDONLY);

@@ -6,6 +6,7 @@
 //    unsorted input between runs is not timed).
 // 2. The paper's figure 6 for K sort chunks in {1,2,4,8,16,32,64}: read time, time from the
 //    end of reading to the first sorted range, and total sort time after reading.
+#include "bench_timing.hpp"
 #include "morton_sorter.hpp"
 #include "point_reader.hpp"
 #include "radix_sort.hpp"
@@ -20,25 +21,13 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using omicron::bench::bestSeconds;
 
 struct KeyIndex {
     std::uint64_t code;
     std::uint32_t index;
     bool operator<(const KeyIndex& other) const { return code < other.code; }
 };
-
-// Best of `runs` timings of fn(); reset() (untimed) restores the unsorted input first.
-template <typename Reset, typename Fn> double bestSeconds(int runs, Reset&& reset, Fn&& fn) {
-    double best = 1e30;
-    for (int i = 0; i < runs; ++i) {
-        reset();
-        const auto start = Clock::now();
-        fn();
-        best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count());
-    }
-    return best;
-}
 
 } // namespace
 
