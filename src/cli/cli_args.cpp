@@ -1,7 +1,10 @@
 #include "cli_args.hpp"
 
+#include "morton_sorter.hpp"
+
 #include <algorithm>
 #include <charconv>
+#include <tbb/info.h>
 
 namespace omicron::cli {
 
@@ -82,6 +85,18 @@ std::uint64_t parseInteger(const std::string& text, const std::string& option, s
                          std::to_string(min) + ".." + std::to_string(max) + ")");
     }
     return value;
+}
+
+int threadsOption(const ParsedArgs& parsed) {
+    const auto text = parsed.value("threads");
+    return text ? static_cast<int>(parseInteger(*text, "threads", 1, 1024))
+                : tbb::info::default_concurrency();
+}
+
+int sortChunksOption(const ParsedArgs& parsed) {
+    const auto text = parsed.value("chunks");
+    return text ? static_cast<int>(parseInteger(*text, "chunks", 1, kMaxSortChunks))
+                : kDefaultSortChunks;
 }
 
 } // namespace omicron::cli

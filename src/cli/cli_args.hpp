@@ -44,4 +44,10 @@ ParsedArgs parseArgs(const std::vector<std::string>& args, const std::vector<Opt
 std::uint64_t parseInteger(const std::string& text, const std::string& option, std::uint64_t min,
                            std::uint64_t max);
 
+// --threads T: worker threads, 1..1024, all cores when absent (sort and build share it).
+int threadsOption(const ParsedArgs& parsed);
+
+// --chunks K: sort chunks, 1..kMaxSortChunks, kDefaultSortChunks when absent.
+int sortChunksOption(const ParsedArgs& parsed);
+
 } // namespace omicron::cli

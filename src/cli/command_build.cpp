@@ -10,7 +10,6 @@
 #include <chrono>
 #include <cstdio>
 #include <tbb/global_control.h>
-#include <tbb/info.h>
 
 namespace omicron::cli {
 
@@ -178,13 +177,9 @@ int runBuild(const std::vector<std::string>& args) {
     if (const auto collapse = parsed.value("collapse")) {
         options.collapse = parseCollapse(*collapse);
     }
-    const int threads = static_cast<int>(parseInteger(
-        parsed.value("threads").value_or(std::to_string(tbb::info::default_concurrency())),
-        "threads", 1, 1024));
+    const int threads = threadsOption(parsed);
     options.threads = threads;
-    const int chunks = static_cast<int>(
-        parseInteger(parsed.value("chunks").value_or(std::to_string(kDefaultSortChunks)), "chunks",
-                     1, kMaxSortChunks));
+    const int chunks = sortChunksOption(parsed);
     tbb::global_control threadLimit(tbb::global_control::max_allowed_parallelism,
                                     static_cast<std::size_t>(threads));
 

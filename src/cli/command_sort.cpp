@@ -11,7 +11,6 @@
 #include <chrono>
 #include <cstdio>
 #include <tbb/global_control.h>
-#include <tbb/info.h>
 
 namespace omicron::cli {
 
@@ -30,12 +29,8 @@ int runSort(const std::vector<std::string>& args) {
     const std::string& inPath = parsed.positionals[0];
     const std::string& outPath = parsed.positionals[1];
     SortOptions options;
-    if (const auto chunks = parsed.value("chunks")) {
-        options.chunks = static_cast<int>(parseInteger(*chunks, "chunks", 1, kMaxSortChunks));
-    }
-    const int threads = static_cast<int>(parseInteger(
-        parsed.value("threads").value_or(std::to_string(tbb::info::default_concurrency())),
-        "threads", 1, 1024));
+    options.chunks = sortChunksOption(parsed);
+    const int threads = threadsOption(parsed);
     tbb::global_control threadLimit(tbb::global_control::max_allowed_parallelism,
                                     static_cast<std::size_t>(threads));
 

@@ -27,10 +27,6 @@ std::uint64_t mix(std::uint64_t x) {
     return x ^ (x >> 31);
 }
 
-template <typename T> void appendAll(std::vector<T>& to, const std::vector<T>& from) {
-    to.insert(to.end(), from.begin(), from.end());
-}
-
 } // namespace
 
 IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const SortOptions& options)
@@ -44,16 +40,8 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
     const auto capacity = static_cast<std::size_t>(info.pointCount);
     m_cloud =
         std::make_shared<SortedCloud>(info.cube, info.sourceOffset, info.attributes, capacity);
-    m_positions.reserve(capacity);
-    if (info.attributes.has(Attribute::Normal)) {
-        m_normals.reserve(capacity);
-    }
-    if (info.attributes.has(Attribute::Color)) {
-        m_colors.reserve(capacity);
-    }
-    if (info.attributes.has(Attribute::Intensity)) {
-        m_intensities.reserve(capacity);
-    }
+    m_input.attributes = info.attributes;
+    m_input.reserve(capacity);
     const std::size_t perBin = capacity / kBins + 16;
     for (Bin& bin : m_bins) {
         bin.codes.reserve(perBin);
@@ -62,7 +50,7 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
 }
 
 void IncrementalMortonSorter::add(const PointBatch& batch) {
-    const std::size_t firstIndex = m_positions.size();
+    const std::size_t firstIndex = m_input.size();
     if (firstIndex + batch.size() > m_cloud->capacity()) {
         throw std::length_error(m_info.path + ": the reader delivered more points than the " +
                                 std::to_string(m_cloud->capacity()) + " its header declared");
@@ -84,10 +72,7 @@ void IncrementalMortonSorter::add(const PointBatch& batch) {
         bin.codes.push_back(code);
         bin.indices.push_back(static_cast<std::uint32_t>(firstIndex + i));
     }
-    appendAll(m_positions, batch.positions);
-    appendAll(m_normals, batch.normals);
-    appendAll(m_colors, batch.colors);
-    appendAll(m_intensities, batch.intensities);
+    m_input.append(batch);
     samplePreview(batch, firstIndex);
 }
 
@@ -101,7 +86,6 @@ void IncrementalMortonSorter::samplePreview(const PointBatch& batch, std::uint64
     // Reservoir sampling: point i replaces a random slot with probability capacity / (i + 1).
     for (std::size_t i = 0; i < batch.size(); ++i) {
         const std::uint64_t index = firstIndex + i;
-        std::size_t slot;
         if (index < capacity) {
             m_preview.positions.push_back(batch.positions[i]);
             if (hasColor) {
@@ -109,7 +93,8 @@ void IncrementalMortonSorter::samplePreview(const PointBatch& batch, std::uint64
             }
             continue;
         }
-        slot = static_cast<std::size_t>(mix(m_options.previewSeed ^ index) % (index + 1));
+        const auto slot =
+            static_cast<std::size_t>(mix(m_options.previewSeed ^ index) % (index + 1));
         if (slot < capacity) {
             m_preview.positions[slot] = batch.positions[i];
             if (hasColor) {
@@ -128,7 +113,7 @@ PreviewSample IncrementalMortonSorter::preview() const {
 // Bin index where each chunk starts, plus kBins at the end: contiguous bin ranges of about
 // total/K points each (empty chunks are dropped, so all-identical points make one chunk).
 std::vector<std::size_t> IncrementalMortonSorter::chunkBinBoundaries() const {
-    const std::uint64_t total = m_positions.size();
+    const std::uint64_t total = m_input.size();
     std::vector<std::size_t> boundaries{0};
     std::uint64_t accumulated = 0;
     int chunk = 1;
@@ -207,24 +192,24 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                    });
                    // Gather every attribute into its sorted place.
                    const std::size_t base = chunkBegin[c];
-                   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, size, 8192),
-                                     [&](const tbb::blocked_range<std::size_t>& range) {
-                                         for (std::size_t i = range.begin(); i < range.end(); ++i) {
-                                             const std::uint32_t from = indices[i];
-                                             cloud.mutableCodes()[base + i] = keys[i];
-                                             cloud.mutablePositions()[base + i] = m_positions[from];
-                                             if (!m_normals.empty()) {
-                                                 cloud.mutableNormals()[base + i] = m_normals[from];
-                                             }
-                                             if (!m_colors.empty()) {
-                                                 cloud.mutableColors()[base + i] = m_colors[from];
-                                             }
-                                             if (!m_intensities.empty()) {
-                                                 cloud.mutableIntensities()[base + i] =
-                                                     m_intensities[from];
-                                             }
-                                         }
-                                     });
+                   tbb::parallel_for(
+                       tbb::blocked_range<std::size_t>(0, size, 8192),
+                       [&](const tbb::blocked_range<std::size_t>& range) {
+                           for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                               const std::uint32_t from = indices[i];
+                               cloud.mutableCodes()[base + i] = keys[i];
+                               cloud.mutablePositions()[base + i] = m_input.positions[from];
+                               if (!m_input.normals.empty()) {
+                                   cloud.mutableNormals()[base + i] = m_input.normals[from];
+                               }
+                               if (!m_input.colors.empty()) {
+                                   cloud.mutableColors()[base + i] = m_input.colors[from];
+                               }
+                               if (!m_input.intensities.empty()) {
+                                   cloud.mutableIntensities()[base + i] = m_input.intensities[from];
+                               }
+                           }
+                       });
                    cloud.publish(chunkBegin[c + 1]);
                    return c;
                }) &

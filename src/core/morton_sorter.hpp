@@ -60,7 +60,7 @@ public:
     // Any thread, any time: a copy of the current preview sample (bounded size).
     PreviewSample preview() const;
 
-    std::uint64_t pointCount() const { return m_positions.size(); }
+    std::uint64_t pointCount() const { return m_input.size(); }
     std::shared_ptr<const SortedCloud> cloud() const { return m_cloud; }
 
     // Sorting phase: sorts chunk after chunk and calls `consumer` for every sorted range, in
@@ -88,10 +88,7 @@ private:
     std::shared_ptr<SortedCloud> m_cloud;
 
     // Input in arrival order (attributes are gathered from here into the sorted cloud).
-    std::vector<glm::vec3> m_positions;
-    std::vector<glm::vec3> m_normals;
-    std::vector<glm::u8vec3> m_colors;
-    std::vector<std::uint16_t> m_intensities;
+    PointBatch m_input;
     std::vector<Bin> m_bins;
     std::vector<morton::Code> m_batchCodes; // scratch for add()
 

@@ -111,6 +111,20 @@ void extendScalar(const std::uint8_t* records, std::size_t count, const FloatRec
     box.finite += finite;
 }
 
+// The optional float normal and uchar colour of one record, shared by both conversions.
+template <bool kNormals, bool kColors>
+inline void copyOptionalAttributes(const std::uint8_t* record, std::array<std::size_t, 3> normalAt,
+                                   std::array<std::size_t, 3> colorAt, glm::vec3* normal,
+                                   glm::u8vec3* color) {
+    if constexpr (kNormals) {
+        *normal = glm::vec3(loadFloat(record + normalAt[0]), loadFloat(record + normalAt[1]),
+                            loadFloat(record + normalAt[2]));
+    }
+    if constexpr (kColors) {
+        *color = glm::u8vec3(record[colorAt[0]], record[colorAt[1]], record[colorAt[2]]);
+    }
+}
+
 template <bool kNormals, bool kColors>
 std::size_t convertScalar(const std::uint8_t* records, std::size_t count,
                           const FloatRecordLayout& layout, const FloatUnitTransform& transform,
@@ -141,13 +155,8 @@ std::size_t convertScalar(const std::uint8_t* records, std::size_t count,
                                 static_cast<double>(y) + offset.y,
                                 static_cast<double>(z) + offset.z);
         positions[r] = glm::vec3((source - origin) * inverseEdge);
-        if constexpr (kNormals) {
-            normals[r] = glm::vec3(loadFloat(record + normalAt[0]), loadFloat(record + normalAt[1]),
-                                   loadFloat(record + normalAt[2]));
-        }
-        if constexpr (kColors) {
-            colors[r] = glm::u8vec3(record[colorAt[0]], record[colorAt[1]], record[colorAt[2]]);
-        }
+        copyOptionalAttributes<kNormals, kColors>(record, normalAt, colorAt, normals + r,
+                                                  colors + r);
     }
     return count;
 }
@@ -236,13 +245,8 @@ std::size_t convertSse2(const std::uint8_t* records, std::size_t count,
         float* position = &positions[r].x;
         _mm_storel_pi(reinterpret_cast<__m64*>(position), unit);
         _mm_store_ss(position + 2, _mm_movehl_ps(unit, unit));
-        if constexpr (kNormals) {
-            normals[r] = glm::vec3(loadFloat(record + normalAt[0]), loadFloat(record + normalAt[1]),
-                                   loadFloat(record + normalAt[2]));
-        }
-        if constexpr (kColors) {
-            colors[r] = glm::u8vec3(record[colorAt[0]], record[colorAt[1]], record[colorAt[2]]);
-        }
+        copyOptionalAttributes<kNormals, kColors>(record, normalAt, colorAt, normals + r,
+                                                  colors + r);
     }
     return count;
 }

@@ -8,8 +8,8 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <glm/vec3.hpp>
 #include <glm/gtc/type_precision.hpp>
+#include <glm/vec3.hpp>
 #include <vector>
 
 namespace omicron {
@@ -64,6 +64,14 @@ struct PointBatch {
         normals.clear();
         colors.clear();
         intensities.clear();
+    }
+
+    // Appends every point of `other`, which has the same attributes.
+    void append(const PointBatch& other) {
+        positions.insert(positions.end(), other.positions.begin(), other.positions.end());
+        normals.insert(normals.end(), other.normals.begin(), other.normals.end());
+        colors.insert(colors.end(), other.colors.begin(), other.colors.end());
+        intensities.insert(intensities.end(), other.intensities.begin(), other.intensities.end());
     }
 
     void reserve(std::size_t count) {

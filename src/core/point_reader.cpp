@@ -16,11 +16,16 @@ namespace omicron {
 
 const char* toString(CloudFormat format) {
     switch (format) {
-    case CloudFormat::PlyAscii: return "PLY ascii";
-    case CloudFormat::PlyBinaryLittleEndian: return "PLY binary little-endian";
-    case CloudFormat::PlyBinaryBigEndian: return "PLY binary big-endian";
-    case CloudFormat::Las: return "LAS";
-    case CloudFormat::Xyz: return "XYZ text";
+    case CloudFormat::PlyAscii:
+        return "PLY ascii";
+    case CloudFormat::PlyBinaryLittleEndian:
+        return "PLY binary little-endian";
+    case CloudFormat::PlyBinaryBigEndian:
+        return "PLY binary big-endian";
+    case CloudFormat::Las:
+        return "LAS";
+    case CloudFormat::Xyz:
+        return "XYZ text";
     }
     return "unknown";
 }
@@ -76,8 +81,7 @@ CloudFormat detectFormat(const std::string& path) {
                          "LAZ (compressed LAS) is not supported; decompress it first, e.g. "
                          "'laszip -i FILE.laz -o FILE.las' or 'pdal translate FILE.laz FILE.las'");
     }
-    if (extension == ".xyz" || extension == ".pts" || extension == ".txt" ||
-        extension == ".csv") {
+    if (extension == ".xyz" || extension == ".pts" || extension == ".txt" || extension == ".csv") {
         return CloudFormat::Xyz;
     }
     throw InputError(InputErrorKind::UnknownFormat, path, InputLocation::byte(0),
@@ -100,24 +104,13 @@ std::unique_ptr<PointReader> openPointCloud(const std::string& path, const OpenO
                      "unrecognised format");
 }
 
-namespace {
-template <typename T> void append(std::vector<T>& to, const std::vector<T>& from) {
-    to.insert(to.end(), from.begin(), from.end());
-}
-} // namespace
-
 LoadedCloud loadPointCloud(const std::string& path, const OpenOptions& options) {
     LoadedCloud cloud;
     auto reader = openPointCloud(path, options);
     cloud.info = reader->info();
     cloud.points.attributes = cloud.info.attributes;
     cloud.points.reserve(static_cast<std::size_t>(cloud.info.pointCount));
-    cloud.summary = reader->read([&](const PointBatch& batch) {
-        append(cloud.points.positions, batch.positions);
-        append(cloud.points.normals, batch.normals);
-        append(cloud.points.colors, batch.colors);
-        append(cloud.points.intensities, batch.intensities);
-    });
+    cloud.summary = reader->read([&](const PointBatch& batch) { cloud.points.append(batch); });
     return cloud;
 }
 

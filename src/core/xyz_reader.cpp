@@ -153,6 +153,20 @@ bool isSkippedLine(std::string_view line) {
     return rest.empty() || rest.front() == '#' || rest.substr(0, 2) == "//";
 }
 
+// The next line that holds content: a UTF-8 byte-order mark at the start of the file is
+// dropped, comment and blank lines are skipped. False at the end of the file.
+bool nextContentLine(LineReader& lines, std::string_view& line) {
+    while (lines.next(line)) {
+        if (lines.lineOffset() == 0 && line.substr(0, kUtf8Bom.size()) == kUtf8Bom) {
+            line.remove_prefix(kUtf8Bom.size());
+        }
+        if (!isSkippedLine(line)) {
+            return true;
+        }
+    }
+    return false;
+}
+
 // One line split and parsed; never throws, so header detection can try any line.
 struct Row {
     std::array<double, kMaxColumns> values{};
@@ -301,13 +315,7 @@ struct XyzScan {
 // The first data line of a file: the lines before it are header lines (or comments).
 void findFirstDataLine(LineReader& lines, Row& row, XyzScan& scan, const std::string& path) {
     std::string_view line;
-    while (lines.next(line)) {
-        if (lines.lineOffset() == 0 && line.substr(0, kUtf8Bom.size()) == kUtf8Bom) {
-            line.remove_prefix(kUtf8Bom.size());
-        }
-        if (isSkippedLine(line)) {
-            continue;
-        }
+    while (nextContentLine(lines, line)) {
         row.parse(line);
         const bool ptsCount = row.columns == 1 && isIntegerLiteral(row.texts[0]);
         if (row.badColumn == 0 && !ptsCount) {
@@ -388,10 +396,7 @@ XyzScan scanFile(FileStream& stream) {
     const int colorColumn = scan.columns == 6 ? -1 : layout.color;
     scanRow(row, layout.intensity, colorColumn, scan, path, scan.dataLine);
     std::string_view line;
-    while (lines.next(line)) {
-        if (isSkippedLine(line)) {
-            continue;
-        }
+    while (nextContentLine(lines, line)) {
         row.parse(line);
         checkRow(row, scan.columns, scan.dataLine, path, lines.lineNumber());
         scanRow(row, layout.intensity, colorColumn, scan, path, lines.lineNumber());
@@ -463,13 +468,7 @@ public:
         LineReader lines(m_stream, m_dataLine);
         Row row;
         std::string_view line;
-        while (lines.next(line)) {
-            if (lines.lineOffset() == 0 && line.substr(0, kUtf8Bom.size()) == kUtf8Bom) {
-                line.remove_prefix(kUtf8Bom.size());
-            }
-            if (isSkippedLine(line)) {
-                continue;
-            }
+        while (nextContentLine(lines, line)) {
             row.parse(line);
             checkRow(row, m_layout.columns, m_dataLine, path, lines.lineNumber());
             if (!row.positionFinite()) {
