@@ -42,6 +42,7 @@ public:
     bool autoFit = true; // frame the cloud until the user moves the camera
     bool glReady = false;
     QString glError;
+    QString glRenderer;
     bool flyMode = false;
     QSet<int> flyKeys;
     QTimer frameTimer;
@@ -220,8 +221,12 @@ FrameStats CloudView::lastFrameStats() const { return d->lastStats; }
 
 QString CloudView::glErrorString() const { return d->glError; }
 
+QString CloudView::glRendererName() const { return d->glRenderer; }
+
 void CloudView::initializeGL() {
     QOpenGLContext* glContext = context();
+    d->glRenderer = QString::fromLatin1(
+        reinterpret_cast<const char*>(glContext->functions()->glGetString(GL_RENDERER)));
     const QSurfaceFormat actual = glContext->format();
     if (actual.majorVersion() < 3 || (actual.majorVersion() == 3 && actual.minorVersion() < 3)) {
         d->glError = QStringLiteral("OpenGL 3.3 or newer is needed; this context has %1.%2")

@@ -60,6 +60,9 @@ public:
     // depth of the last frame; nothing over empty space.
     std::optional<QVector3D> pickPoint(const QPoint& position);
 
+    // GL_RENDERER of the context (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"); empty before it exists.
+    QString glRendererName() const;
+
     // Why nothing is drawn (no OpenGL 3.3, a shader failed); empty when all is well.
     QString glErrorString() const;
 
