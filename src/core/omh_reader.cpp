@@ -444,8 +444,8 @@ std::vector<OctreeNode> OmhReader::readNodes(int level, std::vector<std::uint8_t
         node.coveredBegin = static_cast<std::uint32_t>(firstPoint + points);
         node.pointCount = static_cast<std::uint32_t>(count);
         node.coveredCount = node.pointCount;
-        node.firstChild = nextChild;
         node.childCount = static_cast<std::uint8_t>(std::popcount(mask));
+        node.firstChild = node.childCount > 0 ? nextChild : 0; // a leaf's is 0, as built
         nextChild += node.childCount;
         childMasks[i] = mask;
         for (unsigned octant = 0; octant < 8; ++octant) {

@@ -2,6 +2,7 @@
 // atomically: the target is either the complete new file or left as it was.
 #pragma once
 
+#include "atomic_file_writer.hpp"
 #include "build_options.hpp"
 #include "build_statistics.hpp"
 #include "hierarchy.hpp"
