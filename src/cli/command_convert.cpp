@@ -51,11 +51,11 @@ WholeCloud readWhole(const std::string& path) {
     return whole;
 }
 
-// LAS stores integers: a millimetre step, or finer for a small cloud, against an offset
-// near the data so every coordinate fits in int32.
+// LAS stores integers: a millimetre step, or finer for a small cloud (at most 2^30 steps per
+// cube edge), against the cube's origin, so every coordinate fits in int32.
 LasWriteOptions lasOptions(const WholeCloud& whole) {
     LasWriteOptions options;
-    options.offset = glm::floor(whole.cube.origin);
+    options.offset = whole.cube.origin;
     const double step = std::min(0.001, whole.cube.edge / double(1u << 30));
     options.scale = glm::dvec3(step);
     return options;

@@ -121,3 +121,42 @@ TEST(CliOmh, VerifyOnANonOmhFileIsAUsageError) {
 
 } // namespace
 } // namespace omicron
+
+namespace omicron {
+namespace {
+
+TEST(CliConvert, EveryOutputFormatReadsBackWithTheSamePointCount) {
+    OMICRON_REQUIRE_SHARED_FILE(input, "bunny.ply");
+    test::TempDir dir;
+    for (const char* name : {"b.las", "b.xyz", "b.oms", "b.ply"}) {
+        SCOPED_TRACE(name);
+        const std::string out = dir.file(name);
+        const auto convert = test::runProcess(OMICRON_CLI_PATH, {"convert", input, out});
+        ASSERT_EQ(convert.exitCode, 0) << convert.err;
+        const auto info = test::runProcess(OMICRON_CLI_PATH, {"info", out, "--json"});
+        ASSERT_EQ(info.exitCode, 0) << info.err;
+        EXPECT_NE(info.out.find("\"points_read\":35947"), std::string::npos) << info.out;
+    }
+    EXPECT_EQ(test::runProcess(OMICRON_CLI_PATH, {"convert", input, dir.file("b.doc")}).exitCode,
+              2);
+}
+
+TEST(CliExportPotree, WritesTheThreeFiles) {
+    OMICRON_REQUIRE_SHARED_FILE(input, "bunny.ply");
+    test::TempDir dir;
+    const std::string saved = dir.file("a.omh");
+    ASSERT_EQ(test::runProcess(OMICRON_CLI_PATH, {"build", input, "--save", saved}).exitCode, 0);
+    const auto exported =
+        test::runProcess(OMICRON_CLI_PATH, {"export-potree", saved, dir.file("potree")});
+    ASSERT_EQ(exported.exitCode, 0) << exported.err;
+    for (const char* file : {"metadata.json", "hierarchy.bin", "octree.bin"}) {
+        EXPECT_GT(std::filesystem::file_size(dir.path() / "potree" / file), 0u) << file;
+    }
+    const auto missing =
+        test::runProcess(OMICRON_CLI_PATH, {"export-potree", dir.file("none.omh"), dir.file("p")});
+    EXPECT_EQ(missing.exitCode, 1);
+    EXPECT_NE(missing.err.find("none.omh"), std::string::npos);
+}
+
+} // namespace
+} // namespace omicron
