@@ -5,10 +5,14 @@
 #include "hierarchy_builder.hpp"
 #include "json_writer.hpp"
 #include "oms_reader.hpp"
+#include "omh_writer.hpp"
 #include "point_reader.hpp"
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <thread>
 #include <tbb/global_control.h>
 
 namespace omicron::cli {
@@ -26,7 +30,39 @@ struct BuildRun {
     double readSeconds = 0.0;
     double sortSeconds = 0.0; // 0 for a .oms input: it is sorted already
     std::string pipeline;
+    std::string savedPath; // empty without --save
+    std::uint64_t savedBytes = 0;
 };
+
+// Test hook, not a user option: with OMICRON_TEST_PAUSE_SAVE_AFTER_LEVEL=N in the
+// environment, a save stops for a minute after level N's points went to the temporary file,
+// so a test can kill the process half-way and check that the previous file survives.
+OmhWriteOptions saveOptions() {
+    OmhWriteOptions options;
+    if (const char* pauseLevel = std::getenv("OMICRON_TEST_PAUSE_SAVE_AFTER_LEVEL")) {
+        const int level = std::atoi(pauseLevel);
+        options.afterLevel = [level](int written) {
+            if (written == level) {
+                std::fprintf(stderr, "omicron-cli: save paused after level %d (test hook)\n",
+                             level);
+                std::fflush(stderr);
+                std::this_thread::sleep_for(std::chrono::seconds(60));
+            }
+        };
+    }
+    return options;
+}
+
+// --save: the finished hierarchy as a .omh file (pipeline 3's input).
+void saveIfAsked(const HierarchyBuilder& builder, const std::string& savePath, BuildRun& run) {
+    if (savePath.empty()) {
+        return;
+    }
+    writeOmh(savePath, builder.hierarchy(), omhBuildInfo(builder.options(), run.stats),
+             saveOptions());
+    run.savedPath = savePath;
+    run.savedBytes = std::filesystem::file_size(savePath);
+}
 
 LeafCollapse parseCollapse(const std::string& text) {
     if (text == "off") {
@@ -50,7 +86,8 @@ double parseRatio(const std::string& text) {
     return ratio;
 }
 
-BuildRun buildFromSortedStream(const std::string& path, const BuildOptions& options) {
+BuildRun buildFromSortedStream(const std::string& path, const BuildOptions& options,
+                               const std::string& savePath) {
     BuildRun run;
     run.pipeline = "sorted stream (.oms) -> builder";
     OmsReader reader(path);
@@ -61,10 +98,12 @@ BuildRun buildFromSortedStream(const std::string& path, const BuildOptions& opti
     builder.finish();
     builder.wait();
     run.stats = builder.statistics();
+    saveIfAsked(builder, savePath, run);
     return run;
 }
 
-BuildRun buildFromCloud(const std::string& path, const BuildOptions& options, int chunks) {
+BuildRun buildFromCloud(const std::string& path, const BuildOptions& options, int chunks,
+                        const std::string& savePath) {
     BuildRun run;
     run.pipeline = "unsorted cloud -> incremental sorter -> builder";
     auto reader = openPointCloud(path);
@@ -81,6 +120,7 @@ BuildRun buildFromCloud(const std::string& path, const BuildOptions& options, in
     builder.finish();
     builder.wait();
     run.stats = builder.statistics();
+    saveIfAsked(builder, savePath, run);
     return run;
 }
 
@@ -121,6 +161,10 @@ void printJson(const BuildRun& run, const BuildOptions& options) {
     json.key("fix_passes").value(s.fixPasses);
     json.key("duplicate_parents_merged").value(s.duplicateParentsMerged);
     json.key("complete").value(s.complete);
+    if (!run.savedPath.empty()) {
+        json.key("saved").value(run.savedPath);
+        json.key("saved_bytes").value(run.savedBytes);
+    }
     json.endObject();
     std::printf("%s\n", json.text().c_str());
 }
@@ -146,6 +190,10 @@ void printText(const BuildRun& run, const BuildOptions& options) {
     std::printf("memory:      %.1f MiB resident (%.1f bytes per input point)\n",
                 s.bytesResident() / 1048576.0,
                 s.inputPoints ? double(s.bytesResident()) / double(s.inputPoints) : 0.0);
+    if (!run.savedPath.empty()) {
+        std::printf("saved:       %s (%llu bytes)\n", run.savedPath.c_str(),
+                    static_cast<unsigned long long>(run.savedBytes));
+    }
 }
 
 int runBuild(const std::vector<std::string>& args) {
@@ -155,7 +203,8 @@ int runBuild(const std::vector<std::string>& args) {
                                                {"collapse", true},
                                                {"threads", true},
                                                {"chunks", true},
-                                               {"json", false}});
+                                               {"json", false},
+                                               {"save", true}});
     if (parsed.help) {
         printCommandHelp(buildCommand());
         return 0;
@@ -184,8 +233,9 @@ int runBuild(const std::vector<std::string>& args) {
                                     static_cast<std::size_t>(threads));
 
     const std::string& path = parsed.positionals[0];
-    const BuildRun run = isOmsFile(path) ? buildFromSortedStream(path, options)
-                                         : buildFromCloud(path, options, chunks);
+    const std::string savePath = parsed.value("save").value_or("");
+    const BuildRun run = isOmsFile(path) ? buildFromSortedStream(path, options, savePath)
+                                         : buildFromCloud(path, options, chunks, savePath);
     if (parsed.flag("json")) {
         printJson(run, options);
     } else {
@@ -200,7 +250,7 @@ const Command& buildCommand() {
     static const Command command{
         "build", "build the OMiCroN hierarchy of a cloud and print its statistics",
         "build IN [--depth 7] [--ratio 0.2] [--worklist N] [--collapse off|lossless|paper]\n"
-        "                   [--threads T] [--chunks K] [--json]",
+        "                   [--threads T] [--chunks K] [--save OUT.omh] [--json]",
         "Builds the octree bottom-up with oblique hierarchy cuts while the input streams in:\n"
         "an unsorted cloud (PLY, LAS, XYZ) goes through the incremental Morton sorter first\n"
         "(pipeline 1), a sorted stream (.oms) feeds the builder directly (pipeline 2).\n"
@@ -213,11 +263,15 @@ const Command& buildCommand() {
         "                     points are counted)\n"
         "  --threads T        worker threads (default: all cores)\n"
         "  --chunks K         sort chunks for unsorted input, 1..256 (default 32)\n"
+        "  --save OUT.omh     save the finished hierarchy as a .omh file (written to a\n"
+        "                     temporary file and renamed: an interrupted save leaves OUT as\n"
+        "                     it was); 'info OUT.omh' prints the same per-level counts\n"
         "  --json             one JSON object: points_in, levels [{level, nodes, leaves,\n"
         "                     points}], creation_s, read_s, sort_s, bytes_resident,\n"
-        "                     milestones_s (time at 10 %, 20 %, ... of the points inserted)\n"
+        "                     milestones_s (time at 10 %, 20 %, ... of the points inserted),\n"
+        "                     saved and saved_bytes with --save\n"
         "\n"
-        "Exit status: 0 ok, 1 input error, 2 usage error.\n",
+        "Exit status: 0 ok, 1 input or output error, 2 usage error.\n",
         runBuild};
     return command;
 }

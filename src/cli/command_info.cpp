@@ -4,6 +4,8 @@
 #include "commands.hpp"
 #include "json_writer.hpp"
 #include "oms_reader.hpp"
+#include "omh_info.hpp"
+#include "omh_reader.hpp"
 #include "point_reader.hpp"
 
 #include <chrono>
@@ -150,7 +152,7 @@ InfoReport readSortedStream(const std::string& path) {
 }
 
 int runInfo(const std::vector<std::string>& args) {
-    const ParsedArgs parsed = parseArgs(args, {{"json", false}});
+    const ParsedArgs parsed = parseArgs(args, {{"json", false}, {"verify", false}});
     if (parsed.help) {
         printCommandHelp(infoCommand());
         return 0;
@@ -160,6 +162,13 @@ int runInfo(const std::vector<std::string>& args) {
                          " arguments");
     }
     const std::string& path = parsed.positionals[0];
+    if (isOmhFile(path)) {
+        return printOmhInfo(path, parsed.flag("json"), parsed.flag("verify"));
+    }
+    if (parsed.flag("verify")) {
+        throw UsageError("--verify applies to .omh hierarchy files; other files are always "
+                         "read (and .oms checksums verified) in full");
+    }
     const InfoReport report = isOmsFile(path) ? readSortedStream(path) : readCloud(path);
     if (parsed.flag("json")) {
         printJson(report);
@@ -174,7 +183,7 @@ int runInfo(const std::vector<std::string>& args) {
 const Command& infoCommand() {
     static const Command command{
         "info", "read a point cloud and describe it (format, count, bounds, speed)",
-        "info FILE [--json]",
+        "info FILE [--json] [--verify]",
         "Reads the whole file (PLY, LAS, XYZ text or a .oms sorted stream, whose checksums and\n"
         "Morton order are verified), streaming, and prints its format, the\n"
         "declared and read point counts, the attributes, the bounding box in source units,\n"
@@ -184,6 +193,14 @@ const Command& infoCommand() {
         "  --json   print one JSON object instead (keys: path, format, format_detail,\n"
         "           points_declared, points_read, skipped_non_finite, attributes, bounds,\n"
         "           bounds_from_header, offset, cube, read_s)\n"
+        "\n"
+        "For a .omh hierarchy file it prints the build parameters, the attributes, the cube\n"
+        "and the nodes, leaves and points per level from the header and level table (whose\n"
+        "checksums, and the footer's, are checked); --json gives \"levels\":[{\"level\",\n"
+        "\"nodes\",\"leaves\",\"points\"}] as build --json does.\n"
+        "\n"
+        "  --verify (.omh) also read every node table and point section and compare its\n"
+        "           checksum; exit status 1 on the first mismatch\n"
         "\n"
         "Exit status: 0 ok, 1 the file cannot be read (the message names the file and where),\n"
         "2 a usage error.\n",

@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "hierarchy_builder.hpp"
 #include "input_error.hpp"
+#include "omh_reader.hpp"
 #include "oms_reader.hpp"
 #include "point_reader.hpp"
 
@@ -48,7 +49,14 @@ QSize parseSize(const std::string& text) {
     return QSize(static_cast<int>(width), static_cast<int>(height));
 }
 
-std::shared_ptr<const Hierarchy> buildHierarchy(const std::string& path, const BuildOptions& options) {
+std::shared_ptr<const Hierarchy> loadOrBuildHierarchy(const std::string& path,
+                                                      const BuildOptions& options) {
+    if (isOmhFile(path)) { // pipeline 3: the saved hierarchy, loaded top-down
+        OmhReader reader(path);
+        auto hierarchy = reader.hierarchy();
+        reader.load();
+        return hierarchy;
+    }
     if (isOmsFile(path)) {
         OmsReader reader(path);
         HierarchyBuilder builder(reader.cloud(), options);
@@ -137,7 +145,7 @@ int runRender(const std::vector<std::string>& args) {
         throw OutputError(outPath + ": rendering needs a display for its OpenGL context; none is "
                                     "set (headless machines: run under xvfb-run)");
     }
-    const auto hierarchy = buildHierarchy(inPath, options);
+    const auto hierarchy = loadOrBuildHierarchy(inPath, options);
 
     int argc = 1;
     char programName[] = "omicron-cli";
@@ -173,9 +181,10 @@ const Command& renderCommand() {
         "render IN OUT.png [--camera fit|iso|top|bottom|front|back|left|right] [--size WxH] "
         "[--mode points|splats] [--color rgb|normal|height|intensity|level|age] [--depth N] "
         "[--threshold PX] [--threads T]",
-        "Runs the pipeline (an unsorted cloud is sorted first; a .oms file is streamed), waits\n"
-        "for the hierarchy, and renders it with the viewer's CloudView off screen: the front\n"
-        "converged at the default projection threshold, no point budget.\n\n"
+        "Runs the pipeline (an unsorted cloud is sorted first; a .oms file is streamed; a .omh\n"
+        "hierarchy is loaded), waits for the hierarchy, and renders it with the viewer's\n"
+        "CloudView off screen: the front converged at the projection threshold, no point\n"
+        "budget.\n\n"
         "  --camera   fit (default: the cloud framed from above at an angle), or a standard view\n"
         "             (top looks down z; front looks along +y)\n"
         "  --size     image size in pixels (default 1280x800)\n"

@@ -21,6 +21,8 @@ const Command& sortCommand();
 const Command& exportCommand();
 const Command& buildCommand();
 const Command& renderCommand();
+const Command& convertCommand();
+const Command& exportPotreeCommand();
 
 // Prints "usage: omicron-cli USAGE" and the help text to stdout (for --help).
 void printCommandHelp(const Command& command);

@@ -19,18 +19,19 @@ using omicron::cli::Command;
 constexpr int kExitInputOutput = 1;
 constexpr int kExitUsage = 2;
 
-const std::array<const Command*, 6>& commands() {
-    static const std::array<const Command*, 6> all{
-        &omicron::cli::infoCommand(), &omicron::cli::generateCommand(),
-        &omicron::cli::sortCommand(), &omicron::cli::exportCommand(),
-        &omicron::cli::buildCommand(), &omicron::cli::renderCommand()};
+const std::array<const Command*, 8>& commands() {
+    static const std::array<const Command*, 8> all{
+        &omicron::cli::infoCommand(),    &omicron::cli::generateCommand(),
+        &omicron::cli::sortCommand(),    &omicron::cli::exportCommand(),
+        &omicron::cli::buildCommand(),   &omicron::cli::convertCommand(),
+        &omicron::cli::exportPotreeCommand(), &omicron::cli::renderCommand()};
     return all;
 }
 
 void printGlobalHelp() {
     std::printf("usage: omicron-cli COMMAND [OPTIONS] [ARGS]\n\ncommands:\n");
     for (const Command* command : commands()) {
-        std::printf("  %-10s %s\n", command->name, command->summary);
+        std::printf("  %-14s %s\n", command->name, command->summary);
     }
     std::printf("\n'omicron-cli COMMAND --help' describes a command.\n"
                 "Exit status: 0 ok, 1 input or output error, 2 usage error.\n");

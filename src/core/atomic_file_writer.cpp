@@ -7,6 +7,7 @@
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <filesystem>
+#include <string>
 #include <unistd.h>
 
 namespace omicron {
@@ -81,6 +82,28 @@ void AtomicFileWriter::write(const void* data, std::size_t count) {
         if (m_buffered == m_buffer.size()) {
             flushBuffer();
         }
+    }
+}
+
+void AtomicFileWriter::writeAt(std::uint64_t offset, const void* data, std::size_t count) {
+    if (offset > m_bytesWritten || count > m_bytesWritten - offset) {
+        throw OutputError(m_targetPath + ": writeAt(" + std::to_string(offset) + ", " +
+                          std::to_string(count) + " bytes) beyond the " +
+                          std::to_string(m_bytesWritten) + " bytes written");
+    }
+    flushBuffer();
+    const auto* bytes = static_cast<const char*>(data);
+    while (count > 0) {
+        const ssize_t wrote = ::pwrite(m_fd, bytes, count, static_cast<off_t>(offset));
+        if (wrote < 0) {
+            if (errno == EINTR) {
+                continue;
+            }
+            fail("write failed", errno);
+        }
+        bytes += wrote;
+        count -= static_cast<std::size_t>(wrote);
+        offset += static_cast<std::uint64_t>(wrote);
     }
 }
 

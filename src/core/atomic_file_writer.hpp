@@ -28,6 +28,11 @@ public:
     void write(const void* data, std::size_t count);
     void write(const std::string& text) { write(text.data(), text.size()); }
 
+    // Overwrites `count` bytes at `offset` of what was written already (offset + count <=
+    // bytesWritten()): for fields known only at the end, such as a table of checksums that
+    // precedes the data it covers. Throws OutputError.
+    void writeAt(std::uint64_t offset, const void* data, std::size_t count);
+
     std::uint64_t bytesWritten() const { return m_bytesWritten; }
     const std::string& targetPath() const { return m_targetPath; }
 

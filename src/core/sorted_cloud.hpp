@@ -20,11 +20,22 @@
 
 namespace omicron {
 
+// The order the points of a cloud are stored in.
+enum class CloudOrder {
+    Morton, // non-decreasing level-21 code: what the sorter and the .oms reader produce and the
+            // builder needs (publish() asserts it at range boundaries)
+    // The held points of a stored hierarchy's nodes, concatenated in node (breadth-first)
+    // order, as the .omh reader loads them: a parent's sample repeats points of its leaves,
+    // and codes restart at every level. Only a loaded Hierarchy indexes such a cloud.
+    NodeOrder,
+};
+
 class SortedCloud {
 public:
     SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffset,
-                AttributeSet attributes, std::size_t capacity)
-        : m_cube(cube), m_sourceOffset(sourceOffset), m_attributes(attributes),
+                AttributeSet attributes, std::size_t capacity,
+                CloudOrder order = CloudOrder::Morton)
+        : m_cube(cube), m_sourceOffset(sourceOffset), m_attributes(attributes), m_order(order),
           m_codes(capacity), m_positions(capacity),
           m_normals(attributes.has(Attribute::Normal) ? capacity : 0),
           m_colors(attributes.has(Attribute::Color) ? capacity : 0),
@@ -36,6 +47,7 @@ public:
     const CubeTransform& cube() const { return m_cube; }
     const glm::dvec3& sourceOffset() const { return m_sourceOffset; }
     AttributeSet attributes() const { return m_attributes; }
+    CloudOrder order() const { return m_order; }
     std::size_t capacity() const { return m_codes.size(); }
 
     // End of the finished prefix; everything before it is immutable.
@@ -60,7 +72,7 @@ public:
     void publish(std::size_t newSortedEnd) {
         const std::size_t previous = m_sortedEnd.load(std::memory_order_relaxed);
         assert(newSortedEnd >= previous && newSortedEnd <= capacity());
-        assert(previous == 0 || newSortedEnd == previous ||
+        assert(m_order != CloudOrder::Morton || previous == 0 || newSortedEnd == previous ||
                m_codes[previous - 1] <= m_codes[previous]);
         (void)previous;
         m_sortedEnd.store(newSortedEnd, std::memory_order_release);
@@ -74,6 +86,7 @@ private:
     CubeTransform m_cube;
     glm::dvec3 m_sourceOffset;
     AttributeSet m_attributes;
+    CloudOrder m_order;
     std::vector<morton::Code> m_codes;
     std::vector<glm::vec3> m_positions;
     std::vector<glm::vec3> m_normals;

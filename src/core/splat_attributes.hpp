@@ -88,6 +88,15 @@ public:
     // [parentBegin, parentEnd) are all the points of its parent cell (its sibling group), which
     // a leaf with fewer than 8 points uses instead of its own. Deterministic (a fixed
     // summation order); leaves may be estimated concurrently.
+    // Stores a point's attributes as a saved hierarchy holds them (the .omh reader): the
+    // encoded radius and, when estimatesNormals(), the encoded normal (else it is ignored).
+    void setEncoded(std::size_t point, std::uint16_t encodedRadius, std::uint32_t encodedNormal) {
+        m_radii[point] = encodedRadius;
+        if (m_normals) {
+            m_normals[point] = encodedNormal;
+        }
+    }
+
     void estimateLeaf(std::size_t begin, std::size_t end, int level, std::size_t parentBegin,
                       std::size_t parentEnd, SplatScratch& scratch);
 

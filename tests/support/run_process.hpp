@@ -15,4 +15,23 @@ struct ProcessResult {
 // Runs `program` with `args` (no shell), waits for it and returns its exit code and output.
 ProcessResult runProcess(const std::string& program, const std::vector<std::string>& args);
 
+// A child left running, for tests that kill it part way (e.g. in the middle of a save).
+// Its stdout goes to /dev/null and its stderr to `errPath`; `environment` entries
+// ("NAME=VALUE") are added to this process's environment. The destructor kills (SIGKILL) and
+// reaps a child still running, so a failing test never leaves one behind.
+class RunningProcess {
+public:
+    RunningProcess(const std::string& program, const std::vector<std::string>& args,
+                   const std::vector<std::string>& environment, const std::string& errPath);
+    ~RunningProcess();
+    RunningProcess(const RunningProcess&) = delete;
+    RunningProcess& operator=(const RunningProcess&) = delete;
+
+    // Sends SIGKILL and waits for the child to end.
+    void kill();
+
+private:
+    int m_pid = -1;
+};
+
 } // namespace omicron::test

@@ -1,0 +1,138 @@
+// omicron-cli convert IN OUT: any supported cloud to PLY, LAS, XYZ or a .oms sorted stream,
+// chosen by OUT's extension.
+#include "cli_args.hpp"
+#include "commands.hpp"
+#include "las_writer.hpp"
+#include "morton_sorter.hpp"
+#include "oms_reader.hpp"
+#include "oms_writer.hpp"
+#include "ply_writer.hpp"
+#include "point_reader.hpp"
+#include "xyz_writer.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+namespace omicron::cli {
+
+namespace {
+
+std::string lowerExtension(const std::string& path) {
+    std::string extension = std::filesystem::path(path).extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return extension;
+}
+
+struct WholeCloud {
+    PointBatch points;
+    CubeTransform cube;
+    glm::dvec3 sourceOffset{0.0};
+};
+
+WholeCloud readWhole(const std::string& path) {
+    WholeCloud whole;
+    if (isOmsFile(path)) {
+        OmsReader reader(path);
+        reader.read([](const SortedCloud&, std::size_t, std::size_t) {});
+        const auto cloud = reader.cloud();
+        cloud->copyRange(0, cloud->sortedEnd(), whole.points);
+        whole.cube = cloud->cube();
+        whole.sourceOffset = cloud->sourceOffset();
+        return whole;
+    }
+    LoadedCloud loaded = loadPointCloud(path);
+    whole.points = std::move(loaded.points);
+    whole.cube = loaded.info.cube;
+    whole.sourceOffset = loaded.info.sourceOffset;
+    return whole;
+}
+
+// LAS stores integers: a millimetre step, or finer for a small cloud (at most 2^30 steps per
+// cube edge), against the cube's origin, so every coordinate fits in int32.
+LasWriteOptions lasOptions(const WholeCloud& whole) {
+    LasWriteOptions options;
+    options.offset = whole.cube.origin;
+    const double step = std::min(0.001, whole.cube.edge / double(1u << 30));
+    options.scale = glm::dvec3(step);
+    return options;
+}
+
+void writeSorted(const std::string& inPath, const std::string& outPath) {
+    auto reader = openPointCloud(inPath);
+    OmsWriter writer;
+    sortPointCloud(*reader, SortOptions{},
+                   [&](const SortedCloud& cloud, std::size_t begin, std::size_t end) {
+                       if (begin == 0) {
+                           writer.open(outPath, cloud.cube(), cloud.sourceOffset(),
+                                       cloud.attributes(), cloud.capacity());
+                       }
+                       writer.append(cloud, begin, end);
+                   });
+    writer.finish();
+}
+
+int runConvert(const std::vector<std::string>& args) {
+    const ParsedArgs parsed = parseArgs(args, {});
+    if (parsed.help) {
+        printCommandHelp(convertCommand());
+        return 0;
+    }
+    if (parsed.positionals.size() != 2) {
+        throw UsageError("expected IN and OUT, found " +
+                         std::to_string(parsed.positionals.size()) + " arguments");
+    }
+    const std::string& inPath = parsed.positionals[0];
+    const std::string& outPath = parsed.positionals[1];
+    const std::string extension = lowerExtension(outPath);
+    if (extension == ".oms") {
+        if (isOmsFile(inPath)) {
+            throw UsageError("IN is already a .oms sorted stream");
+        }
+        writeSorted(inPath, outPath);
+        std::printf("converted %s to the sorted stream %s\n", inPath.c_str(), outPath.c_str());
+        return 0;
+    }
+    if (extension != ".ply" && extension != ".las" && extension != ".xyz" &&
+        extension != ".txt") {
+        throw UsageError("OUT must end in .ply, .las, .xyz, .txt or .oms, found '" + outPath +
+                         "'");
+    }
+    const WholeCloud whole = readWhole(inPath);
+    if (extension == ".ply") {
+        PlyWriteOptions options;
+        options.offset = plyStorageOffset(whole.cube, whole.sourceOffset);
+        options.comments.push_back("converted by omicron-cli from " + inPath);
+        writePly(outPath, whole.points, whole.cube, options);
+    } else if (extension == ".las") {
+        writeLas(outPath, whole.points, whole.cube, lasOptions(whole));
+    } else {
+        writeXyz(outPath, whole.points, whole.cube);
+    }
+    std::printf("converted %zu points from %s to %s\n", whole.points.size(), inPath.c_str(),
+                outPath.c_str());
+    return 0;
+}
+
+} // namespace
+
+const Command& convertCommand() {
+    static const Command command{
+        "convert", "convert a cloud to PLY, LAS, XYZ or a .oms sorted stream",
+        "convert IN OUT",
+        "Reads IN (PLY, LAS, XYZ text or .oms) and writes OUT in the format its extension\n"
+        "names: .ply (binary little-endian, float coordinates against a 'comment offset'),\n"
+        "LAS 1.2 point format 3 (.las, millimetre steps or finer), XYZ text (.xyz, .txt) or a\n"
+        "Morton-sorted stream (.oms, from a cloud that is not one already). Points keep\n"
+        "their colour, normal and intensity where the output format has the field. OUT is\n"
+        "replaced atomically.\n"
+        "\n"
+        "Exit status: 0 ok, 1 input or output error, 2 usage error.\n",
+        runConvert};
+    return command;
+}
+
+} // namespace omicron::cli

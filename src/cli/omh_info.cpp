@@ -1,0 +1,123 @@
+#include "omh_info.hpp"
+
+#include "json_writer.hpp"
+#include "omh_reader.hpp"
+
+#include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace omicron::cli {
+
+namespace {
+
+void writeVector(JsonWriter& json, const glm::dvec3& v) {
+    json.beginArray().value(v.x).value(v.y).value(v.z).endArray();
+}
+
+std::vector<const char*> attributeNames(AttributeSet attributes) {
+    std::vector<const char*> names;
+    for (const auto& [attribute, name] : {std::pair{Attribute::Normal, "normal"},
+                                          std::pair{Attribute::Color, "color"},
+                                          std::pair{Attribute::Intensity, "intensity"}}) {
+        if (attributes.has(attribute)) {
+            names.push_back(name);
+        }
+    }
+    return names;
+}
+
+void printJson(const omh::Header& h, bool verified) {
+    JsonWriter json;
+    json.beginObject();
+    json.key("path").value(h.path);
+    json.key("format").value("OMH hierarchy");
+    json.key("version").value(std::uint64_t{h.version});
+    json.key("file_bytes").value(h.fileBytes);
+    json.key("depth").value(static_cast<std::uint64_t>(h.build.maxLevel));
+    json.key("ratio").value(h.build.ratio);
+    json.key("collapse").value(toString(h.build.collapse));
+    json.key("points_in").value(h.build.inputPoints);
+    json.key("dropped_points").value(h.build.droppedPoints);
+    json.key("collapsed_leaves").value(h.build.collapsedLeaves);
+    json.key("attributes").beginArray();
+    for (const char* name : attributeNames(h.attributes)) {
+        json.value(name);
+    }
+    json.endArray();
+    json.key("estimated_normals").value(h.estimatedNormals);
+    json.key("record_bytes").value(static_cast<std::uint64_t>(h.recordBytes));
+    json.key("offset");
+    writeVector(json, h.sourceOffset);
+    json.key("cube").beginObject();
+    json.key("origin");
+    writeVector(json, h.cube.origin);
+    json.key("edge").value(h.cube.edge);
+    json.endObject();
+    json.key("levels").beginArray();
+    for (std::size_t level = 0; level < h.levels.size(); ++level) {
+        json.beginObject();
+        json.key("level").value(static_cast<std::uint64_t>(level));
+        json.key("nodes").value(h.levels[level].nodes);
+        json.key("leaves").value(h.levels[level].leaves);
+        json.key("points").value(h.levels[level].points);
+        json.endObject();
+    }
+    json.endArray();
+    json.key("nodes").value(h.totalNodes);
+    json.key("points_stored").value(h.totalPoints);
+    json.key("verified").value(verified);
+    json.endObject();
+    std::printf("%s\n", json.text().c_str());
+}
+
+void printText(const omh::Header& h, bool verified) {
+    std::string attributes;
+    for (const char* name : attributeNames(h.attributes)) {
+        attributes.append(attributes.empty() ? "" : ", ").append(name);
+    }
+    std::printf("file:        %s\n", h.path.c_str());
+    std::printf("format:      OMH hierarchy, version %u, %llu bytes, %zu-byte point records\n",
+                h.version, static_cast<unsigned long long>(h.fileBytes), h.recordBytes);
+    std::printf("parameters:  depth %d, ratio %.3g, leaf collapse %s\n", h.build.maxLevel,
+                h.build.ratio, toString(h.build.collapse));
+    std::printf("points:      %llu in, %llu dropped by leaf collapse, %llu leaves collapsed, "
+                "%llu stored\n",
+                static_cast<unsigned long long>(h.build.inputPoints),
+                static_cast<unsigned long long>(h.build.droppedPoints),
+                static_cast<unsigned long long>(h.build.collapsedLeaves),
+                static_cast<unsigned long long>(h.totalPoints));
+    std::printf("attributes:  %s%s\n", attributes.empty() ? "none" : attributes.c_str(),
+                h.estimatedNormals ? " (+ estimated normals)" : "");
+    std::printf("cube:        origin %.6f %.6f %.6f, edge %.6f; offset %.6f %.6f %.6f\n",
+                h.cube.origin.x, h.cube.origin.y, h.cube.origin.z, h.cube.edge,
+                h.sourceOffset.x, h.sourceOffset.y, h.sourceOffset.z);
+    std::printf("level  nodes        leaves       points\n");
+    for (std::size_t level = 0; level < h.levels.size(); ++level) {
+        std::printf("%5zu  %-11llu  %-11llu  %llu\n", level,
+                    static_cast<unsigned long long>(h.levels[level].nodes),
+                    static_cast<unsigned long long>(h.levels[level].leaves),
+                    static_cast<unsigned long long>(h.levels[level].points));
+    }
+    std::printf("checksums:   %s\n", verified ? "every section verified"
+                                               : "header, level table and footer verified "
+                                                 "(--verify checks every section)");
+}
+
+} // namespace
+
+int printOmhInfo(const std::string& path, bool json, bool verify) {
+    OmhReader reader(path);
+    if (verify) {
+        reader.verify();
+    }
+    if (json) {
+        printJson(reader.header(), verify);
+    } else {
+        printText(reader.header(), verify);
+    }
+    return 0;
+}
+
+} // namespace omicron::cli

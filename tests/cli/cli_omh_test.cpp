@@ -1,0 +1,162 @@
+// omicron-cli build --save / info on .omh files, driven as a user would: the per-level counts
+// agree, --verify catches damage, and a save killed half-way leaves the old file usable.
+#include "run_process.hpp"
+#include "test_files.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+namespace omicron {
+namespace {
+
+using test::runProcess;
+
+// The "levels":[...] array of a JSON report, verbatim.
+std::string levelsArray(const std::string& json) {
+    const std::regex levels(R"re("levels":\[[^\]]*\])re");
+    std::smatch match;
+    return std::regex_search(json, match, levels) ? match.str() : std::string();
+}
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+TEST(CliOmh, InfoPrintsTheSameLevelsAsBuildJson) {
+    OMICRON_REQUIRE_SHARED_FILE(input, "bunny.ply");
+    test::TempDir dir;
+    const std::string saved = dir.file("a.omh");
+    for (const char* collapse : {"off", "paper"}) {
+        SCOPED_TRACE(collapse);
+        const auto build = runProcess(OMICRON_CLI_PATH, {"build", input, "--depth", "6",
+                                                         "--collapse", collapse, "--save", saved,
+                                                         "--json"});
+        ASSERT_EQ(build.exitCode, 0) << build.err;
+        EXPECT_NE(build.out.find("\"saved\":"), std::string::npos);
+        const auto info = runProcess(OMICRON_CLI_PATH, {"info", saved, "--json", "--verify"});
+        ASSERT_EQ(info.exitCode, 0) << info.err;
+        const std::string levels = levelsArray(build.out);
+        ASSERT_NE(levels, "");
+        EXPECT_EQ(levelsArray(info.out), levels);
+        EXPECT_NE(info.out.find("\"verified\":true"), std::string::npos);
+        EXPECT_NE(info.out.find(std::string("\"collapse\":\"") + collapse + "\""),
+                  std::string::npos);
+    }
+    const auto text = runProcess(OMICRON_CLI_PATH, {"info", saved});
+    ASSERT_EQ(text.exitCode, 0) << text.err;
+    EXPECT_NE(text.out.find("OMH hierarchy"), std::string::npos);
+}
+
+TEST(CliOmh, VerifyExitsOneOnADamagedSectionAndNamesIt) {
+    OMICRON_REQUIRE_SHARED_FILE(input, "bunny.ply");
+    test::TempDir dir;
+    const std::string saved = dir.file("a.omh");
+    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"build", input, "--depth", "5", "--save", saved})
+                  .exitCode,
+              0);
+    std::vector<std::uint8_t> bytes = test::readBytes(saved);
+    bytes[bytes.size() - 100] ^= 0x10; // in the deepest level's point records
+    test::writeBytes(saved, bytes);
+    EXPECT_EQ(runProcess(OMICRON_CLI_PATH, {"info", saved}).exitCode, 0)
+        << "without --verify only the header, level table and footer are read";
+    const auto verify = runProcess(OMICRON_CLI_PATH, {"info", saved, "--verify"});
+    EXPECT_EQ(verify.exitCode, 1);
+    EXPECT_NE(verify.err.find(saved), std::string::npos) << verify.err;
+    EXPECT_NE(verify.err.find("point records of level 5"), std::string::npos) << verify.err;
+}
+
+TEST(CliOmh, SaveIntoAMissingFolderFailsNamingTheFile) {
+    OMICRON_REQUIRE_SHARED_FILE(input, "bunny.ply");
+    test::TempDir dir;
+    const std::string target = dir.file("missing/a.omh");
+    const auto build = runProcess(OMICRON_CLI_PATH, {"build", input, "--save", target});
+    EXPECT_EQ(build.exitCode, 1);
+    EXPECT_NE(build.err.find(target), std::string::npos) << build.err;
+}
+
+TEST(CliOmh, ASaveKilledHalfWayLeavesThePreviousFileIntact) {
+    OMICRON_REQUIRE_SHARED_FILE(input, "bunny.ply");
+    test::TempDir dir;
+    const std::string saved = dir.file("a.omh");
+    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"build", input, "--depth", "4", "--save", saved})
+                  .exitCode,
+              0);
+    const std::vector<std::uint8_t> before = test::readBytes(saved);
+
+    const std::string errPath = dir.file("stderr");
+    test::RunningProcess child(OMICRON_CLI_PATH, {"build", input, "--depth", "7", "--save", saved},
+                               {"OMICRON_TEST_PAUSE_SAVE_AFTER_LEVEL=5"}, errPath);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (slurp(errPath).find("save paused") == std::string::npos) {
+        ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "the save never paused";
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    // The paused save has its temporary file beside the target.
+    bool temporary = false;
+    for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+        temporary |= entry.path().filename().string().starts_with(".a.omh.tmp-");
+    }
+    EXPECT_TRUE(temporary);
+    child.kill();
+
+    EXPECT_EQ(test::readBytes(saved), before);
+    const auto info = runProcess(OMICRON_CLI_PATH, {"info", saved, "--verify", "--json"});
+    EXPECT_EQ(info.exitCode, 0) << info.err;
+    EXPECT_NE(info.out.find("\"depth\":4"), std::string::npos);
+}
+
+TEST(CliOmh, VerifyOnANonOmhFileIsAUsageError) {
+    OMICRON_REQUIRE_SHARED_FILE(input, "bunny.ply");
+    EXPECT_EQ(runProcess(OMICRON_CLI_PATH, {"info", input, "--verify"}).exitCode, 2);
+}
+
+} // namespace
+} // namespace omicron
+
+namespace omicron {
+namespace {
+
+TEST(CliConvert, EveryOutputFormatReadsBackWithTheSamePointCount) {
+    OMICRON_REQUIRE_SHARED_FILE(input, "bunny.ply");
+    test::TempDir dir;
+    for (const char* name : {"b.las", "b.xyz", "b.oms", "b.ply"}) {
+        SCOPED_TRACE(name);
+        const std::string out = dir.file(name);
+        const auto convert = test::runProcess(OMICRON_CLI_PATH, {"convert", input, out});
+        ASSERT_EQ(convert.exitCode, 0) << convert.err;
+        const auto info = test::runProcess(OMICRON_CLI_PATH, {"info", out, "--json"});
+        ASSERT_EQ(info.exitCode, 0) << info.err;
+        EXPECT_NE(info.out.find("\"points_read\":35947"), std::string::npos) << info.out;
+    }
+    EXPECT_EQ(test::runProcess(OMICRON_CLI_PATH, {"convert", input, dir.file("b.doc")}).exitCode,
+              2);
+}
+
+TEST(CliExportPotree, WritesTheThreeFiles) {
+    OMICRON_REQUIRE_SHARED_FILE(input, "bunny.ply");
+    test::TempDir dir;
+    const std::string saved = dir.file("a.omh");
+    ASSERT_EQ(test::runProcess(OMICRON_CLI_PATH, {"build", input, "--save", saved}).exitCode, 0);
+    const auto exported =
+        test::runProcess(OMICRON_CLI_PATH, {"export-potree", saved, dir.file("potree")});
+    ASSERT_EQ(exported.exitCode, 0) << exported.err;
+    for (const char* file : {"metadata.json", "hierarchy.bin", "octree.bin"}) {
+        EXPECT_GT(std::filesystem::file_size(dir.path() / "potree" / file), 0u) << file;
+    }
+    const auto missing =
+        test::runProcess(OMICRON_CLI_PATH, {"export-potree", dir.file("none.omh"), dir.file("p")});
+    EXPECT_EQ(missing.exitCode, 1);
+    EXPECT_NE(missing.err.find("none.omh"), std::string::npos);
+}
+
+} // namespace
+} // namespace omicron
