@@ -2,31 +2,15 @@
 // builder), then the build statistics as text or JSON.
 #include "cli_args.hpp"
 #include "commands.hpp"
-#include "hierarchy_builder.hpp"
+#include "build_pipeline.hpp"
 #include "json_writer.hpp"
-#include "oms_reader.hpp"
-#include "point_reader.hpp"
 
-#include <chrono>
 #include <cstdio>
 #include <tbb/global_control.h>
 
 namespace omicron::cli {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-struct BuildRun {
-    BuildStatistics stats;
-    double readSeconds = 0.0;
-    double sortSeconds = 0.0; // 0 for a .oms input: it is sorted already
-    std::string pipeline;
-};
 
 LeafCollapse parseCollapse(const std::string& text) {
     if (text == "off") {
@@ -50,41 +34,7 @@ double parseRatio(const std::string& text) {
     return ratio;
 }
 
-BuildRun buildFromSortedStream(const std::string& path, const BuildOptions& options) {
-    BuildRun run;
-    run.pipeline = "sorted stream (.oms) -> builder";
-    OmsReader reader(path);
-    HierarchyBuilder builder(reader.cloud(), options);
-    const auto readStart = Clock::now();
-    reader.read(builder.consumer());
-    run.readSeconds = secondsSince(readStart);
-    builder.finish();
-    builder.wait();
-    run.stats = builder.statistics();
-    return run;
-}
-
-BuildRun buildFromCloud(const std::string& path, const BuildOptions& options, int chunks) {
-    BuildRun run;
-    run.pipeline = "unsorted cloud -> incremental sorter -> builder";
-    auto reader = openPointCloud(path);
-    SortOptions sortOptions;
-    sortOptions.chunks = chunks;
-    IncrementalMortonSorter sorter(reader->info(), sortOptions);
-    HierarchyBuilder builder(sorter.cloud(), options);
-    const auto readStart = Clock::now();
-    reader->read([&](const PointBatch& batch) { sorter.add(batch); });
-    run.readSeconds = secondsSince(readStart);
-    const auto sortStart = Clock::now();
-    sorter.sortAndEmit(builder.consumer());
-    run.sortSeconds = secondsSince(sortStart);
-    builder.finish();
-    builder.wait();
-    run.stats = builder.statistics();
-    return run;
-}
-
-void printJson(const BuildRun& run, const BuildOptions& options) {
+void printJson(const PipelineResult& run, const BuildOptions& options) {
     const BuildStatistics& s = run.stats;
     JsonWriter json;
     json.beginObject();
@@ -125,7 +75,7 @@ void printJson(const BuildRun& run, const BuildOptions& options) {
     std::printf("%s\n", json.text().c_str());
 }
 
-void printText(const BuildRun& run, const BuildOptions& options) {
+void printText(const PipelineResult& run, const BuildOptions& options) {
     const BuildStatistics& s = run.stats;
     std::printf("pipeline:    %s\n", run.pipeline.c_str());
     std::printf("parameters:  depth %d, ratio %.3g, worklist %zu, leaf collapse %s\n",
@@ -184,8 +134,8 @@ int runBuild(const std::vector<std::string>& args) {
                                     static_cast<std::size_t>(threads));
 
     const std::string& path = parsed.positionals[0];
-    const BuildRun run = isOmsFile(path) ? buildFromSortedStream(path, options)
-                                         : buildFromCloud(path, options, chunks);
+    BuildPipeline pipeline;
+    const PipelineResult run = pipeline.run(path, {options, chunks});
     if (parsed.flag("json")) {
         printJson(run, options);
     } else {
