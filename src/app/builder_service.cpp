@@ -130,6 +130,7 @@ void BuilderService::submit(Job job) {
 
 void BuilderService::startJob(Job job) {
     joinWorker(); // the previous worker has already posted its result: returns at once
+    m_pipeline->resetCancel(); // before the thread starts: a cancel() after this one counts
     setBusy(true);
     m_currentIsBuild = job.build;
     m_currentOpensSource = job.opensSource;

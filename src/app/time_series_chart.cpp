@@ -22,7 +22,7 @@ TimeSeriesChart::TimeSeriesChart(const QString& title, const QString& unit,
     chart->legend()->setVisible(lineNames.size() > 1);
     chart->legend()->setAlignment(Qt::AlignBottom);
     // Small panels: short labels in a small font, the unit in the title instead of axis titles.
-    chart->setTitle(QStringLiteral("%1 (%2 / s)").arg(title, unit));
+    chart->setTitle(QStringLiteral("%1 (%2)").arg(title, unit));
     QFont labelFont = chart->font();
     labelFont.setPointSizeF(7.0);
     m_axisX = new QValueAxis(chart);

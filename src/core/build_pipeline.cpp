@@ -87,7 +87,6 @@ PipelineResult BuildPipeline::run(const std::string& path, const PipelineOptions
 }
 
 void BuildPipeline::beginRun(BuildPhase phase) {
-    m_cancel.store(false);
     m_pointsRead.store(0);
     m_generation.fetch_add(1);
     setPhase(phase);
@@ -238,6 +237,12 @@ PipelineResult BuildPipeline::runGeneratedScene(std::uint64_t points, std::uint6
                                                 const PipelineOptions& options) {
     validate(options.build);
     beginRun(BuildPhase::Opening);
+    if (cancelled()) { // generation itself cannot stop part way: do not start it
+        setPhase(BuildPhase::Cancelled);
+        PipelineResult result;
+        result.cancelled = true;
+        return result;
+    }
     const GeneratedScene scene = generateScene(points, seed);
     CloudInfo info;
     info.format = CloudFormat::Xyz; // unused for a sorter fed from memory

@@ -117,9 +117,12 @@ public:
     // no file is read. Throws std::logic_error when no complete sorted cloud is kept.
     PipelineResult rebuild(const BuildOptions& options);
 
-    // Any thread: stops the current run at the next batch, chunk or fix level; a no-op when
-    // idle. The flag is cleared when the next run starts.
+    // Any thread: stops the current run at the next batch, chunk or fix level. The request
+    // stays until resetCancel(), so a cancel that races with the start of a run (issued
+    // before the run's thread got going) still stops it: every later run returns at once,
+    // cancelled, until the owner calls resetCancel() before starting the next one.
     void cancel();
+    void resetCancel() { m_cancel.store(false); }
 
     // ---- Any thread. ----
     PipelineProgress progress() const;

@@ -215,7 +215,9 @@ TEST(BuildPipeline, CancelStopsARunPromptly) {
     EXPECT_FALSE(pipeline.hasCompleteCloud());
     EXPECT_THROW(pipeline.rebuild(BuildOptions{}), std::logic_error);
     EXPECT_LT(seconds, 30.0);
-    // The object stays usable: the next run starts with the flag cleared.
+    // The request stays until reset; then the object is usable again.
+    EXPECT_TRUE(pipeline.runGeneratedScene(10'000, 1, smallOptions()).cancelled);
+    pipeline.resetCancel();
     EXPECT_TRUE(pipeline.runGeneratedScene(10'000, 1, smallOptions()).stats.complete);
 }
 
