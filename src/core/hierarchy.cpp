@@ -6,7 +6,8 @@
 namespace omicron {
 
 Hierarchy::Hierarchy(std::shared_ptr<const SortedCloud> cloud, int maxLevel)
-    : m_cloud(std::move(cloud)), m_maxLevel(maxLevel), m_splats(*m_cloud) {
+    : m_cloud(std::move(cloud)), m_maxLevel(maxLevel), m_insertions(m_cloud->capacity()),
+      m_splats(*m_cloud) {
     assert(maxLevel >= 0 && maxLevel <= morton::kMaxLevel);
     m_levels.reserve(static_cast<std::size_t>(maxLevel) + 1);
     for (int level = 0; level <= maxLevel; ++level) {
@@ -74,6 +75,21 @@ void Hierarchy::publishNodes(int level) {
     }
 }
 
+void Hierarchy::appendInsertion(const CutInsertion& insertion) {
+    auto& entries = m_insertions.entries;
+    assert(entries.size() == 0 ||
+           morton::span(entries[entries.size() - 1].leafCode, m_maxLevel) <
+               morton::span(insertion.leafCode, m_maxLevel));
+    entries.push_back(insertion);
+}
+
+void Hierarchy::publishInsertions() {
+    if (m_insertions.published.load(std::memory_order_relaxed) != m_insertions.entries.size()) {
+        m_insertions.published.store(m_insertions.entries.size(), std::memory_order_release);
+        bumpEpoch();
+    }
+}
+
 void Hierarchy::publishFixedThrough(int level, morton::Code delimiter) {
     m_levels[level]->fixedThrough.store(delimiter, std::memory_order_release);
 }
@@ -93,6 +109,7 @@ std::size_t Hierarchy::nodeBytes() const {
     for (const auto& level : m_levels) {
         bytes += level->nodes.bytesAllocated();
     }
+
     return bytes;
 }
 

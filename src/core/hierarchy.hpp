@@ -11,6 +11,9 @@
 //     fixedThrough(l); after a whole fix pass, cutDelimiter() (the paper's m_C); both release.
 // What a render front may hold (invariant 2.2: no root of the cut, no child of a root) follows
 // from these delimiters alone: see isSettled().
+// The builder also keeps an append-only insertion log: every leaf it concatenates to the cut,
+// in span order, published with a release count like the nodes. A render front appends one
+// placeholder per entry (see front.hpp) and so learns of new leaves without a queue or a lock.
 #pragma once
 
 #include "chunked_arena.hpp"
@@ -21,6 +24,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <memory>
 #include <optional>
@@ -38,8 +42,21 @@ struct PublishedCut {
     bool complete = false;   // the build finished: every node is settled
 };
 
+// One entry of the insertion log: a leaf the builder concatenated to the cut. A leaf at
+// maxLevel is a node already (published with its level); a collapsed leaf (shallower) travels
+// the cut as a placeholder and becomes a node when fix reaches its level. Either way the entry
+// names the leaf itself, and entries are in span order (the order of concatenation).
+struct CutInsertion {
+    morton::Code leafCode = 0;       // the leaf's own code, at its own level
+    std::uint32_t coveredBegin = 0;  // the SortedCloud range the leaf covers
+    std::uint32_t coveredCount = 0;
+    std::chrono::steady_clock::time_point publishedAt{}; // when the builder published it
+};
+
 class Hierarchy {
 public:
+    static constexpr std::size_t kInsertionsPerChunk = 4096;
+
     static constexpr std::size_t kNodesPerChunk = 1024;
 
     Hierarchy(std::shared_ptr<const SortedCloud> cloud, int maxLevel);
@@ -80,6 +97,16 @@ public:
     // only more conservative.
     static bool isSettled(morton::Code code, const PublishedCut& cut, int maxLevel);
 
+    // Entries of the insertion log published so far (acquire); [0, insertionCount) never
+    // change. Empty for a hierarchy not grown by a builder (a loaded file).
+    std::size_t insertionCount() const {
+        return m_insertions.published.load(std::memory_order_acquire);
+    }
+    // `index` must be below an insertionCount() this thread loaded.
+    const CutInsertion& insertion(std::size_t index) const {
+        return m_insertions.entries[index];
+    }
+
     // ---- Builder side: one thread. ----
 
     // Appends a complete node to `level` (Morton order). Not visible before publishNodes().
@@ -89,6 +116,9 @@ public:
     SplatAttributes& mutableSplats() { return m_splats; }
 
     void publishNodes(int level);
+    // Appends to the insertion log (span order); not visible before publishInsertions().
+    void appendInsertion(const CutInsertion& insertion);
+    void publishInsertions();
     void publishFixedThrough(int level, morton::Code delimiter);
     void publishCutDelimiter(morton::Code delimiter);
     void markComplete();
@@ -96,6 +126,7 @@ public:
     // Memory held by the hierarchy itself (the SortedCloud it indexes is not included).
     std::size_t nodeBytes() const;
     std::size_t sampleBytes() const { return m_samples.bytesAllocated(); }
+    std::size_t insertionLogBytes() const { return m_insertions.entries.bytesAllocated(); }
     std::size_t splatBytes() const { return m_splats.bytesResident(); }
 
 private:
@@ -106,11 +137,18 @@ private:
         std::atomic<morton::Code> fixedThrough{0};
     };
 
+    struct InsertionLog {
+        explicit InsertionLog(std::size_t capacity) : entries(capacity) {}
+        ChunkedArena<CutInsertion, kInsertionsPerChunk> entries;
+        std::atomic<std::size_t> published{0};
+    };
+
     void bumpEpoch() { m_epoch.fetch_add(1, std::memory_order_release); }
 
     std::shared_ptr<const SortedCloud> m_cloud;
     int m_maxLevel;
     std::vector<std::unique_ptr<Level>> m_levels;
+    InsertionLog m_insertions; // every leaf covers at least one point: capacity = the cloud's
     SampleStore m_samples;
     SplatAttributes m_splats;
     std::atomic<morton::Code> m_cutDelimiter{0};

@@ -351,6 +351,15 @@ void HierarchyBuilder::insertInput(std::size_t available, bool inputEnded) {
         leafLevel.points += run.count;
     }
     m_hierarchy->publishNodes(maxLevel);
+    // The render front's hand-off (front.hpp): what is concatenated, in the same span order,
+    // naming the leaf itself (a collapsed leaf is not a node yet). Published after the leaves
+    // so that an entry's maxLevel leaf is always published when the entry is.
+    const auto publishedAt = std::chrono::steady_clock::now();
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+        const morton::Code leafCode = collapsed(i) ? runs[i].code >> 3 : runs[i].code;
+        m_hierarchy->appendInsertion({leafCode, runs[i].begin, runs[i].count, publishedAt});
+    }
+    m_hierarchy->publishInsertions();
     m_cut.concatenate(roots);
     m_insertedEnd = end;
     m_stats.inputPoints = end;
