@@ -6,7 +6,8 @@
 
 namespace omicron {
 
-BuildPanel::BuildPanel(QWidget* parent) : QWidget(parent), m_ui(std::make_unique<Ui::BuildPanel>()) {
+BuildPanel::BuildPanel(QWidget* parent)
+    : QWidget(parent), m_ui(std::make_unique<Ui::BuildPanel>()) {
     m_ui->setupUi(this);
     m_ui->depthSpin->setMaximum(morton::kMaxLevel);
     m_ui->chunksSpin->setMaximum(kMaxSortChunks);
@@ -14,7 +15,9 @@ BuildPanel::BuildPanel(QWidget* parent) : QWidget(parent), m_ui(std::make_unique
     setViewParameters(ViewParameters{});
     connect(m_ui->rebuildButton, &QPushButton::clicked, this, &BuildPanel::requestRebuild);
     connect(m_ui->cancelButton, &QPushButton::clicked, this, &BuildPanel::cancelRequested);
-    const auto viewEdited = [this] { emit viewParametersChanged(viewParameters()); };
+    const auto viewEdited = [this] {
+        emit viewParametersChanged(viewParameters());
+    };
     connect(m_ui->thresholdSpin, &QDoubleSpinBox::valueChanged, this, viewEdited);
     connect(m_ui->budgetSpin, &QSpinBox::valueChanged, this, viewEdited);
     connect(m_ui->splatCombo, &QComboBox::currentIndexChanged, this, viewEdited);
@@ -61,8 +64,8 @@ void BuildPanel::loadSettings(const QSettings& settings) {
     PipelineOptions options;
     // The spin boxes clamp what a hand-edited settings file may hold.
     options.build.maxLevel = settings.value("build/depth", defaults.build.maxLevel).toInt();
-    options.build.collapse = static_cast<LeafCollapse>(
-        std::clamp(settings.value("build/collapse", 0).toInt(), 0, 2));
+    options.build.collapse =
+        static_cast<LeafCollapse>(std::clamp(settings.value("build/collapse", 0).toInt(), 0, 2));
     options.build.ratio = settings.value("build/ratio", defaults.build.ratio).toDouble();
     options.build.worklistSize =
         settings.value("build/worklist", qulonglong(defaults.build.worklistSize)).toULongLong();
@@ -93,8 +96,12 @@ void BuildPanel::saveSettings(QSettings& settings) const {
     settings.setValue("view/splats", view.splats);
 }
 
-void BuildPanel::setBusy(bool busy) { m_ui->cancelButton->setEnabled(busy); }
+void BuildPanel::setBusy(bool busy) {
+    m_ui->cancelButton->setEnabled(busy);
+}
 
-void BuildPanel::requestRebuild() { emit rebuildRequested(pipelineOptions().build); }
+void BuildPanel::requestRebuild() {
+    emit rebuildRequested(pipelineOptions().build);
+}
 
 } // namespace omicron

@@ -20,7 +20,9 @@ BuilderService::BuilderService(QObject* parent)
     connect(&m_poll, &QTimer::timeout, this, &BuilderService::poll);
 }
 
-BuilderService::~BuilderService() { shutdown(); }
+BuilderService::~BuilderService() {
+    shutdown();
+}
 
 void BuilderService::open(const QString& path) {
     const std::string file = path.toStdString();
@@ -36,11 +38,13 @@ void BuilderService::open(const QString& path) {
 
 void BuilderService::openGeneratedScene(std::uint64_t points, std::uint64_t seed) {
     m_openJob = [points, seed](const PipelineOptions& options) {
-        return Job{tr("generated scene"), true,
+        return Job{tr("generated scene"),
+                   true,
                    [points, seed, options](BuildPipeline& pipeline) {
                        return JobOutcome{pipeline.runGeneratedScene(points, seed, options), {}};
                    },
-                   {}, true};
+                   {},
+                   true};
     };
     submit(m_openJob(m_options));
 }
@@ -66,7 +70,8 @@ bool BuilderService::rebuild(const BuildOptions& options) {
     const QString title = source && !source->path.empty()
                               ? QFileInfo(QString::fromStdString(source->path)).fileName()
                               : tr("generated scene");
-    submit({title, true,
+    submit({title,
+            true,
             [options](BuildPipeline& pipeline) {
                 return JobOutcome{pipeline.rebuild(options), {}};
             },
@@ -100,20 +105,22 @@ bool BuilderService::exportPoints(const QString& path) {
     submit({QFileInfo(path).fileName(), false,
             [file, cloud, path](BuildPipeline&) {
                 exportCloudPoints(file, *cloud);
-                return JobOutcome{{}, tr("Exported %1 points to %2").arg(cloud->sortedEnd()).arg(path)};
+                return JobOutcome{{},
+                                  tr("Exported %1 points to %2").arg(cloud->sortedEnd()).arg(path)};
             },
             path});
     return true;
 }
 
 void BuilderService::openHierarchy(const QString& path) {
-    emit failed(path, tr("%1: hierarchy files (.omh, pipeline 3) are not available in this build")
-                          .arg(path));
+    emit failed(
+        path,
+        tr("%1: hierarchy files (.omh, pipeline 3) are not available in this build").arg(path));
 }
 
 bool BuilderService::saveHierarchy(const QString& path) {
-    emit failed(path, tr("%1: saving hierarchy files (.omh) is not available in this build")
-                          .arg(path));
+    emit failed(path,
+                tr("%1: saving hierarchy files (.omh) is not available in this build").arg(path));
     return false;
 }
 
@@ -129,7 +136,7 @@ void BuilderService::submit(Job job) {
 }
 
 void BuilderService::startJob(Job job) {
-    joinWorker(); // the previous worker has already posted its result: returns at once
+    joinWorker();              // the previous worker has already posted its result: returns at once
     m_pipeline->resetCancel(); // before the thread starts: a cancel() after this one counts
     setBusy(true);
     m_currentIsBuild = job.build;

@@ -93,7 +93,7 @@ private:
         QString title;
         bool build = true; // builds report progress and end with buildFinished
         std::function<JobOutcome(BuildPipeline&)> work;
-        QString path; // the file involved, for error messages
+        QString path;             // the file involved, for error messages
         bool opensSource = false; // reads a file or the scene (replaces the kept cloud)
     };
 

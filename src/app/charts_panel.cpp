@@ -57,9 +57,13 @@ void ChartsPanel::startBuild() {
     m_building = true;
 }
 
-void ChartsPanel::setProgress(const PipelineProgress& progress) { m_progress = progress; }
+void ChartsPanel::setProgress(const PipelineProgress& progress) {
+    m_progress = progress;
+}
 
-void ChartsPanel::setHierarchyBytes(std::size_t bytes) { m_hierarchyBytes = bytes; }
+void ChartsPanel::setHierarchyBytes(std::size_t bytes) {
+    m_hierarchyBytes = bytes;
+}
 
 void ChartsPanel::setFrame(double frameMs, double frontMs, double fps, std::size_t frontNodes) {
     m_haveFrame = true;
@@ -84,8 +88,8 @@ void ChartsPanel::sample() {
         m_inserted->append(0, now, static_cast<double>(m_progress.pointsInserted));
         m_inserted->append(1, now, static_cast<double>(m_progress.pointsSorted));
         if (m_progress.pointsTotal > 0) {
-            m_inserted->setLine(2, {QPointF(0.0, 0.0),
-                                    QPointF(now, static_cast<double>(m_progress.pointsTotal))});
+            m_inserted->setLine(
+                2, {QPointF(0.0, 0.0), QPointF(now, static_cast<double>(m_progress.pointsTotal))});
         }
         if (m_progress.pointsSorted > 0) {
             m_sortedHistory.emplace_back(now, m_progress.pointsSorted);

@@ -43,8 +43,8 @@ int CutPanel::sweptPermille(morton::Code delimiter, int maxLevel) {
     if (delimiter <= first) {
         return 0;
     }
-    const long double swept = static_cast<long double>(delimiter - first) /
-                              static_cast<long double>(last - first);
+    const long double swept =
+        static_cast<long double>(delimiter - first) / static_cast<long double>(last - first);
     return static_cast<int>(std::min<long double>(1000.0L, swept * 1000.0L));
 }
 
@@ -72,11 +72,10 @@ void CutPanel::setProgress(const PipelineProgress& progress) {
     m_ui->insertedBar->setFormat(barText(progress.pointsInserted, total));
     const int swept = sweptPermille(progress.cutDelimiter, progress.maxLevel);
     m_ui->cutBar->setValue(swept);
-    m_ui->cutBar->setFormat(progress.cutDelimiter == 0
-                                ? tr("no fix pass yet")
-                                : QStringLiteral("%1 %  (m_C = 0x%2)")
-                                      .arg(swept / 10.0, 0, 'f', 1)
-                                      .arg(progress.cutDelimiter, 0, 16));
+    m_ui->cutBar->setFormat(progress.cutDelimiter == 0 ? tr("no fix pass yet")
+                                                       : QStringLiteral("%1 %  (m_C = 0x%2)")
+                                                             .arg(swept / 10.0, 0, 'f', 1)
+                                                             .arg(progress.cutDelimiter, 0, 16));
 }
 
 void CutPanel::setStatistics(const BuildStatistics& statistics) {

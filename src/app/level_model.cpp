@@ -70,8 +70,8 @@ QVariant LevelModel::headerData(int section, Qt::Orientation orientation, int ro
         return {};
     }
     static const char* const titles[ColumnCount] = {
-        QT_TR_NOOP("Level"),  QT_TR_NOOP("Roots in L_C"), QT_TR_NOOP("Nodes"),
-        QT_TR_NOOP("Leaves"), QT_TR_NOOP("Points"),       QT_TR_NOOP("Placeholders pending"),
+        QT_TR_NOOP("Level"),      QT_TR_NOOP("Roots in L_C"), QT_TR_NOOP("Nodes"),
+        QT_TR_NOOP("Leaves"),     QT_TR_NOOP("Points"),       QT_TR_NOOP("Placeholders pending"),
         QT_TR_NOOP("Substituted")};
     static const char* const tips[ColumnCount] = {
         QT_TR_NOOP("Octree level (0 = root)"),

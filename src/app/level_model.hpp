@@ -13,8 +13,16 @@ namespace omicron {
 class LevelModel : public QAbstractTableModel {
     Q_OBJECT
 public:
-    enum Column { Level, CutRoots, Nodes, Leaves, Points, PlaceholdersPending,
-                  PlaceholdersSubstituted, ColumnCount };
+    enum Column {
+        Level,
+        CutRoots,
+        Nodes,
+        Leaves,
+        Points,
+        PlaceholdersPending,
+        PlaceholdersSubstituted,
+        ColumnCount
+    };
 
     explicit LevelModel(QObject* parent = nullptr);
 

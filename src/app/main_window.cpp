@@ -34,8 +34,7 @@ namespace omicron {
 namespace {
 
 QString mib(std::size_t bytes) {
-    return QString::number(static_cast<double>(bytes) / 1048576.0, 'f', 0) +
-           QStringLiteral(" MiB");
+    return QString::number(static_cast<double>(bytes) / 1048576.0, 'f', 0) + QStringLiteral(" MiB");
 }
 
 } // namespace
@@ -131,7 +130,8 @@ void MainWindow::connectActions() {
             openFile(path);
         }
     });
-    connect(m_ui->actionOpenDefaultScene, &QAction::triggered, this, [this] { openDefaultScene(); });
+    connect(m_ui->actionOpenDefaultScene, &QAction::triggered, this,
+            [this] { openDefaultScene(); });
     connect(m_ui->actionSaveHierarchy, &QAction::triggered, this, [this] {
         const QString path = askSavePath(tr("Save Hierarchy As"), tr("Hierarchies (*.omh)"), "omh");
         if (!path.isEmpty()) {
@@ -146,8 +146,8 @@ void MainWindow::connectActions() {
         }
     });
     connect(m_ui->actionExportPoints, &QAction::triggered, this, [this] {
-        const QString path = askSavePath(tr("Export Points"),
-                                         tr("PLY (*.ply);;LAS (*.las)"), "ply");
+        const QString path =
+            askSavePath(tr("Export Points"), tr("PLY (*.ply);;LAS (*.las)"), "ply");
         if (!path.isEmpty()) {
             exportPoints(path);
         }
@@ -213,14 +213,18 @@ void MainWindow::connectActions() {
         {m_ui->actionColorLevel, ColorMode::Level},
         {m_ui->actionColorBuildAge, ColorMode::BuildAge}};
     for (const auto& [action, mode] : colors) {
-        connect(action, &QAction::triggered, this,
-                [editSettings, mode = mode] { editSettings([&](RenderSettings& s) { s.color = mode; }); });
+        connect(action, &QAction::triggered, this, [editSettings, mode = mode] {
+            editSettings([&](RenderSettings& s) { s.color = mode; });
+        });
     }
     connect(m_ui->actionPointSizeLarger, &QAction::triggered, this, [editSettings] {
-        editSettings([](RenderSettings& s) { s.pointSizeScale = std::min(16.0f, s.pointSizeScale * 1.25f); });
+        editSettings([](RenderSettings& s) {
+            s.pointSizeScale = std::min(16.0f, s.pointSizeScale * 1.25f);
+        });
     });
     connect(m_ui->actionPointSizeSmaller, &QAction::triggered, this, [editSettings] {
-        editSettings([](RenderSettings& s) { s.pointSizeScale = std::max(0.1f, s.pointSizeScale / 1.25f); });
+        editSettings(
+            [](RenderSettings& s) { s.pointSizeScale = std::max(0.1f, s.pointSizeScale / 1.25f); });
     });
     connect(m_ui->actionPointSizeReset, &QAction::triggered, this,
             [editSettings] { editSettings([](RenderSettings& s) { s.pointSizeScale = 1.0f; }); });
@@ -235,9 +239,12 @@ void MainWindow::connectActions() {
     });
     connect(m_ui->actionFit, &QAction::triggered, m_view, &CloudView::fitToCloud);
     const std::pair<QAction*, StandardView> views[] = {
-        {m_ui->actionViewTop, StandardView::Top},     {m_ui->actionViewBottom, StandardView::Bottom},
-        {m_ui->actionViewFront, StandardView::Front}, {m_ui->actionViewBack, StandardView::Back},
-        {m_ui->actionViewLeft, StandardView::Left},   {m_ui->actionViewRight, StandardView::Right},
+        {m_ui->actionViewTop, StandardView::Top},
+        {m_ui->actionViewBottom, StandardView::Bottom},
+        {m_ui->actionViewFront, StandardView::Front},
+        {m_ui->actionViewBack, StandardView::Back},
+        {m_ui->actionViewLeft, StandardView::Left},
+        {m_ui->actionViewRight, StandardView::Right},
         {m_ui->actionViewIso, StandardView::Iso}};
     for (const auto& [action, standard] : views) {
         connect(action, &QAction::triggered, m_view,
@@ -255,10 +262,10 @@ void MainWindow::connectActions() {
     for (QMenu* menu : {m_ui->menuRenderMode, m_ui->menuColorMode, m_ui->menuStandardViews}) {
         menu->setEnabled(false);
     }
-    for (QAction* action : {m_ui->actionPointSizeLarger, m_ui->actionPointSizeSmaller,
-                            m_ui->actionPointSizeReset, m_ui->actionFit, m_ui->actionFlyMode,
-                            m_ui->actionShowOctreeCells, m_ui->actionShowCutBoundary,
-                            m_ui->actionShowAxes, m_ui->actionSaveScreenshot}) {
+    for (QAction* action :
+         {m_ui->actionPointSizeLarger, m_ui->actionPointSizeSmaller, m_ui->actionPointSizeReset,
+          m_ui->actionFit, m_ui->actionFlyMode, m_ui->actionShowOctreeCells,
+          m_ui->actionShowCutBoundary, m_ui->actionShowAxes, m_ui->actionSaveScreenshot}) {
         action->setEnabled(false);
     }
 #endif
@@ -280,7 +287,8 @@ void MainWindow::connectService() {
                 // Read, sort and insert each take a third of the bar.
                 const double total = std::max<double>(1.0, double(progress.pointsTotal));
                 m_progressBar->setValue(static_cast<int>(
-                    1000.0 * (progress.pointsRead + progress.pointsSorted + progress.pointsInserted) /
+                    1000.0 *
+                    (progress.pointsRead + progress.pointsSorted + progress.pointsInserted) /
                     (3.0 * total)));
                 updateStatus();
             });
@@ -302,12 +310,11 @@ void MainWindow::connectService() {
     connect(m_service, &BuilderService::buildFinished, this, [this](const PipelineResult& result) {
         const QLocale locale;
         statusBar()->showMessage(
-            result.cancelled
-                ? tr("Build of %1 cancelled").arg(m_title)
-                : tr("%1: %2 points, %3 nodes in %4 s")
-                      .arg(m_title, locale.toString(quint64(result.stats.inputPoints)),
-                           locale.toString(quint64(result.stats.totalNodes())))
-                      .arg(result.stats.creationSeconds, 0, 'f', 2),
+            result.cancelled ? tr("Build of %1 cancelled").arg(m_title)
+                             : tr("%1: %2 points, %3 nodes in %4 s")
+                                   .arg(m_title, locale.toString(quint64(result.stats.inputPoints)),
+                                        locale.toString(quint64(result.stats.totalNodes())))
+                                   .arg(result.stats.creationSeconds, 0, 'f', 2),
             10000);
     });
     connect(m_service, &BuilderService::jobFinished, this,
@@ -336,11 +343,17 @@ void MainWindow::openDefaultScene(quint64 points) {
     m_service->openGeneratedScene(points, kDefaultSceneSeed);
 }
 
-void MainWindow::saveHierarchy(const QString& path) { m_service->saveHierarchy(path); }
+void MainWindow::saveHierarchy(const QString& path) {
+    m_service->saveHierarchy(path);
+}
 
-void MainWindow::exportSortedStream(const QString& path) { m_service->exportSortedStream(path); }
+void MainWindow::exportSortedStream(const QString& path) {
+    m_service->exportSortedStream(path);
+}
 
-void MainWindow::exportPoints(const QString& path) { m_service->exportPoints(path); }
+void MainWindow::exportPoints(const QString& path) {
+    m_service->exportPoints(path);
+}
 
 bool MainWindow::saveScreenshot(const QString& path) {
 #ifdef OMICRON_HAVE_CLOUD_VIEW
@@ -363,10 +376,11 @@ void MainWindow::showError(const QString& path, const QString& message) {
         previous->deleteLater();
         previous->setObjectName(QString());
     }
-    auto* box = new QMessageBox(QMessageBox::Critical, tr("omicron"),
-                                path.isEmpty() ? tr("The operation failed.")
-                                               : tr("Cannot use %1").arg(QFileInfo(path).fileName()),
-                                QMessageBox::Ok, this);
+    auto* box =
+        new QMessageBox(QMessageBox::Critical, tr("omicron"),
+                        path.isEmpty() ? tr("The operation failed.")
+                                       : tr("Cannot use %1").arg(QFileInfo(path).fileName()),
+                        QMessageBox::Ok, this);
     box->setObjectName(QStringLiteral("errorDialog"));
     box->setInformativeText(message);
     box->setAttribute(Qt::WA_DeleteOnClose);
@@ -438,9 +452,8 @@ void MainWindow::updateRecentMenu() {
     QAction* before = m_ui->actionClearRecent;
     for (int i = 0; i < m_recentFiles.size(); ++i) {
         const QString path = m_recentFiles.at(i);
-        auto* action = new QAction(QStringLiteral("&%1 %2").arg((i + 1) % 10).arg(
-                                       QFileInfo(path).fileName()),
-                                   menu);
+        auto* action = new QAction(
+            QStringLiteral("&%1 %2").arg((i + 1) % 10).arg(QFileInfo(path).fileName()), menu);
         action->setToolTip(path);
         action->setStatusTip(path);
         connect(action, &QAction::triggered, this, [this, path] { openFile(path); });
@@ -486,9 +499,9 @@ void MainWindow::applyViewParameters(const ViewParameters& parameters) {
 
 QString MainWindow::askSavePath(const QString& title, const QString& filter,
                                 const QString& suffix) {
-    QFileDialog dialog(this, title, m_recentFiles.isEmpty()
-                                        ? QString()
-                                        : QFileInfo(m_recentFiles.first()).absolutePath(),
+    QFileDialog dialog(this, title,
+                       m_recentFiles.isEmpty() ? QString()
+                                               : QFileInfo(m_recentFiles.first()).absolutePath(),
                        filter);
     dialog.setAcceptMode(QFileDialog::AcceptSave);
     dialog.setDefaultSuffix(suffix);
@@ -504,9 +517,10 @@ void MainWindow::showShortcuts() {
             if (action->menu() != nullptr) {
                 self(action->menu(), self);
             } else if (!action->shortcut().isEmpty()) {
-                rows += QStringLiteral("<tr><td>%1</td><td>%2</td></tr>")
-                            .arg(action->shortcut().toString(QKeySequence::NativeText).toHtmlEscaped(),
-                                 action->text().remove(QLatin1Char('&')).toHtmlEscaped());
+                rows +=
+                    QStringLiteral("<tr><td>%1</td><td>%2</td></tr>")
+                        .arg(action->shortcut().toString(QKeySequence::NativeText).toHtmlEscaped(),
+                             action->text().remove(QLatin1Char('&')).toHtmlEscaped());
             }
         }
     };

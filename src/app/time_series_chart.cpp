@@ -3,9 +3,9 @@
 #include <QChart>
 #include <QContextMenuEvent>
 #include <QFile>
-#include <QFont>
 #include <QFileDialog>
 #include <QFileInfo>
+#include <QFont>
 #include <QLineSeries>
 #include <QMenu>
 #include <QTextStream>
@@ -138,9 +138,9 @@ void TimeSeriesChart::contextMenuEvent(QContextMenuEvent* event) {
     const bool asPng = chosen == png;
     const QString suggested = m_title.toLower().replace(QLatin1Char(' '), QLatin1Char('-')) +
                               (asPng ? QStringLiteral(".png") : QStringLiteral(".csv"));
-    const QString path = QFileDialog::getSaveFileName(
-        this, chosen->text(), suggested,
-        asPng ? tr("PNG images (*.png)") : tr("CSV files (*.csv)"));
+    const QString path =
+        QFileDialog::getSaveFileName(this, chosen->text(), suggested,
+                                     asPng ? tr("PNG images (*.png)") : tr("CSV files (*.csv)"));
     if (path.isEmpty()) {
         return;
     }

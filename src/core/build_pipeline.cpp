@@ -137,8 +137,13 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
         auto sorter = std::make_shared<IncrementalMortonSorter>(info, sortOptions);
         PipelineResult result;
         result.pipeline = toString(PipelineKind::UnsortedCloud);
-        result.source = {path, describeCloud(info), PipelineKind::UnsortedCloud, info.pointCount,
-                         info.attributes, info.cube, info.sourceOffset};
+        result.source = {path,
+                         describeCloud(info),
+                         PipelineKind::UnsortedCloud,
+                         info.pointCount,
+                         info.attributes,
+                         info.cube,
+                         info.sourceOffset};
         setSource(result.source, sorter->cloud());
         {
             std::lock_guard lock(m_mutex);
@@ -258,8 +263,12 @@ PipelineResult BuildPipeline::runGeneratedScene(std::uint64_t points, std::uint6
     auto sorter = std::make_shared<IncrementalMortonSorter>(info, sortOptions);
     PipelineResult result;
     result.pipeline = toString(PipelineKind::GeneratedScene);
-    result.source = {"",          describeCloud(info), PipelineKind::GeneratedScene,
-                     info.pointCount, info.attributes,  info.cube,
+    result.source = {"",
+                     describeCloud(info),
+                     PipelineKind::GeneratedScene,
+                     info.pointCount,
+                     info.attributes,
+                     info.cube,
                      info.sourceOffset};
     setSource(result.source, sorter->cloud());
     {

@@ -32,14 +32,14 @@ namespace omicron {
 
 // Where the pipeline stands; ordered as a build advances.
 enum class BuildPhase : int {
-    Idle,       // nothing run yet
-    Opening,    // parsing the header (and the bounds pre-pass), or generating the scene
-    Reading,    // streaming points into the sorter (pipeline 1)
-    Sorting,    // emitting sorted chunks (pipeline 1) or streaming a .oms file (pipeline 2)
-    Building,   // all input handed to the builder; the hierarchy is being completed
-    Complete,   // the hierarchy is complete
-    Cancelled,  // cancel() stopped the run; the cut built so far stays valid
-    Failed,     // the run threw (the exception went to the caller)
+    Idle,      // nothing run yet
+    Opening,   // parsing the header (and the bounds pre-pass), or generating the scene
+    Reading,   // streaming points into the sorter (pipeline 1)
+    Sorting,   // emitting sorted chunks (pipeline 1) or streaming a .oms file (pipeline 2)
+    Building,  // all input handed to the builder; the hierarchy is being completed
+    Complete,  // the hierarchy is complete
+    Cancelled, // cancel() stopped the run; the cut built so far stays valid
+    Failed,    // the run threw (the exception went to the caller)
 };
 
 const char* toString(BuildPhase phase);
@@ -67,12 +67,12 @@ struct PipelineProgress {
 
 // What the source is, known once it is opened.
 struct PipelineSource {
-    std::string path; // empty for the generated scene
+    std::string path;        // empty for the generated scene
     std::string description; // e.g. "PLY binary little endian, 35947 points"
     PipelineKind kind = PipelineKind::UnsortedCloud;
     std::uint64_t pointCount = 0;
     AttributeSet attributes;
-    CubeTransform cube;            // unit cube -> source units
+    CubeTransform cube; // unit cube -> source units
     glm::dvec3 sourceOffset{0.0};
 };
 
@@ -80,8 +80,8 @@ struct PipelineSource {
 struct PipelineResult {
     PipelineSource source;
     BuildStatistics stats;
-    double readSeconds = 0.0;  // streaming the points (and, for .oms, the sorted ranges)
-    double sortSeconds = 0.0;  // sorter emission after the read; 0 for .oms and rebuild
+    double readSeconds = 0.0; // streaming the points (and, for .oms, the sorted ranges)
+    double sortSeconds = 0.0; // sorter emission after the read; 0 for .oms and rebuild
     std::uint64_t skippedNonFinite = 0;
     bool cancelled = false;
     std::string pipeline; // human-readable, e.g. "unsorted cloud -> incremental sorter -> builder"

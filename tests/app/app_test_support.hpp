@@ -14,6 +14,6 @@ QString sharedDataFile(const QString& name);
 #define OMICRON_REQUIRE_SHARED_FILE(VAR, NAME)                                                     \
     const QString VAR = ::omicron::apptest::sharedDataFile(NAME);                                  \
     if (VAR.isEmpty()) {                                                                           \
-        QSKIP(qPrintable(QStringLiteral("shared data file %1 is absent (../shared/data)")         \
-                             .arg(NAME)));                                                         \
+        QSKIP(qPrintable(                                                                          \
+            QStringLiteral("shared data file %1 is absent (../shared/data)").arg(NAME)));          \
     }

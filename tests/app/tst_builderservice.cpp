@@ -26,7 +26,9 @@ PipelineOptions testOptions(int depth = 6) {
 }
 
 PipelineResult waitForBuild(QSignalSpy& finished, QSignalSpy& failed) {
-    [&] { QTRY_VERIFY_WITH_TIMEOUT(finished.count() + failed.count() > 0, kBuildTimeoutMs); }();
+    [&] {
+        QTRY_VERIFY_WITH_TIMEOUT(finished.count() + failed.count() > 0, kBuildTimeoutMs);
+    }();
     if (failed.count() > 0) {
         qWarning() << "build failed:" << failed.first();
         return {};
@@ -83,7 +85,8 @@ void TestBuilderService::openSharedFileReportsMonotonicThrottledProgress() {
     QVERIFY(progress.count() >= 1);
     // <= 10 Hz: one per 100 ms tick, plus the final poll when the worker returns.
     QVERIFY2(progress.count() <= seconds * 10.0 + 2.0,
-             qPrintable(QStringLiteral("%1 progress signals in %2 s").arg(progress.count()).arg(seconds)));
+             qPrintable(
+                 QStringLiteral("%1 progress signals in %2 s").arg(progress.count()).arg(seconds)));
     PipelineProgress previous;
     for (const QList<QVariant>& signal : progress) {
         const auto p = signal.at(0).value<PipelineProgress>();
@@ -144,7 +147,8 @@ void TestBuilderService::malformedFileIsReportedByNameAndTheHierarchyIsKept() {
     service.open(bad);
     QTRY_VERIFY_WITH_TIMEOUT(failed.count() == 1, kBuildTimeoutMs);
     QCOMPARE(failed.first().at(0).toString(), bad);
-    QVERIFY2(failed.first().at(1).toString().contains(bad), qPrintable(failed.first().at(1).toString()));
+    QVERIFY2(failed.first().at(1).toString().contains(bad),
+             qPrintable(failed.first().at(1).toString()));
     QTRY_VERIFY(!service.busy());
     QCOMPARE(service.hierarchy(), kept);
     QCOMPARE(finished.count(), 0);

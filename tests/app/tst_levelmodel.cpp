@@ -69,7 +69,8 @@ void TestLevelModel::reportsTheNumbersOfEachLevel() {
              quint64(3 * 64 * 10));
     QCOMPARE(model.headerData(LevelModel::CutRoots, Qt::Horizontal).toString(),
              QStringLiteral("Roots in L_C"));
-    QVERIFY(!model.headerData(LevelModel::Nodes, Qt::Horizontal, Qt::ToolTipRole).toString().isEmpty());
+    QVERIFY(
+        !model.headerData(LevelModel::Nodes, Qt::Horizontal, Qt::ToolTipRole).toString().isEmpty());
     QVERIFY(!model.headerData(0, Qt::Vertical).isValid());
 }
 
