@@ -1,12 +1,13 @@
 // Render-front CPU cost and insertion delay on a scripted camera path, while a build runs
 // and after it (the CPU part of the render benchmark; the GPU part belongs to the widget).
 //
-// usage: front_bench FILE [--depth D] [--feed-seconds S] [--after-frames N]
+// usage: front_bench FILE [--depth D] [--feed-seconds S] [--after-frames N] [--threshold PX]
 //   (e.g. ../shared/data/autzen_south.ply, depth 7)
 // The file is read and Morton-sorted first; then a HierarchyBuilder receives the sorted cloud
 // in 256 ranges paced over S seconds (default 2: a stream arriving, as from a .oms file or a
 // sorter), while this thread evaluates a Front at 60 Hz on an orbit that zooms in and out,
-// with the default FrontOptions (100 px threshold, 4 M point budget, 2 ms CPU budget). After
+// with the default FrontOptions (100 px threshold unless --threshold, 4 M point budget, 2 ms
+// CPU budget). After
 // the build, N more frames (default 300) on the same path. Printed per phase: evaluation ms
 // per frame (median, p95, max), front size, visible points; then the insertion delay (leaf
 // published -> substituted, ms and 60 Hz frames; leaf settled -> substituted, evaluations)
@@ -96,18 +97,22 @@ omicron::FrontCamera cameraAt(double seconds, const glm::dvec3& target) {
 int main(int argc, char** argv) {
     if (argc < 2) {
         std::fprintf(stderr,
-                     "usage: front_bench FILE [--depth D] [--feed-seconds S] [--after-frames N]\n");
+                     "usage: front_bench FILE [--depth D] [--feed-seconds S] [--after-frames N] "
+                     "[--threshold PX]\n");
         return 2;
     }
     const std::string path = argv[1];
     int depth = 7;
     double feedSeconds = 2.0;
     int afterFrames = 300;
+    omicron::FrontOptions options; // the defaults a viewer starts with
     for (int i = 2; i + 1 < argc; i += 2) {
         if (std::strcmp(argv[i], "--depth") == 0) {
             depth = std::atoi(argv[i + 1]);
         } else if (std::strcmp(argv[i], "--feed-seconds") == 0) {
             feedSeconds = std::atof(argv[i + 1]);
+        } else if (std::strcmp(argv[i], "--threshold") == 0) {
+            options.projectionThresholdPx = std::atof(argv[i + 1]);
         } else if (std::strcmp(argv[i], "--after-frames") == 0) {
             afterFrames = std::atoi(argv[i + 1]);
         } else {
@@ -150,7 +155,6 @@ int main(int argc, char** argv) {
         });
 
         omicron::Front front(hierarchy);
-        const omicron::FrontOptions options; // the defaults a viewer starts with
         Phase building, after;
         std::vector<double> delayMs;
         std::vector<std::uint32_t> settledEvaluations;
@@ -191,12 +195,14 @@ int main(int argc, char** argv) {
         }
 
         std::printf("bench=front file=%s points=%zu depth=%d leaves=%llu nodes=%llu "
-                    "feed_s=%.2f build_s=%.2f frames=%d\n",
+                    "feed_s=%.2f build_s=%.2f frames=%d threshold_px=%.1f point_budget=%zu "
+                    "cpu_budget_ms=%.1f\n",
                     path.c_str(), points, depth,
                     static_cast<unsigned long long>(stats.levels[depth].leaves +
                                                     stats.collapsedLeaves),
                     static_cast<unsigned long long>(stats.totalNodes()), feedSeconds,
-                    buildSeconds, frame);
+                    buildSeconds, frame, options.projectionThresholdPx, options.pointBudget,
+                    options.cpuBudgetMs);
         building.print("during_build");
         after.print("after_build");
         wholeSweep.print("whole_sweep_baseline");

@@ -20,6 +20,7 @@ const Command& generateCommand();
 const Command& sortCommand();
 const Command& exportCommand();
 const Command& buildCommand();
+const Command& renderCommand();
 
 // Prints "usage: omicron-cli USAGE" and the help text to stdout (for --help).
 void printCommandHelp(const Command& command);

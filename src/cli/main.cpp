@@ -19,11 +19,11 @@ using omicron::cli::Command;
 constexpr int kExitInputOutput = 1;
 constexpr int kExitUsage = 2;
 
-const std::array<const Command*, 5>& commands() {
-    static const std::array<const Command*, 5> all{
+const std::array<const Command*, 6>& commands() {
+    static const std::array<const Command*, 6> all{
         &omicron::cli::infoCommand(), &omicron::cli::generateCommand(),
         &omicron::cli::sortCommand(), &omicron::cli::exportCommand(),
-        &omicron::cli::buildCommand()};
+        &omicron::cli::buildCommand(), &omicron::cli::renderCommand()};
     return all;
 }
 

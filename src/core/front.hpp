@@ -49,7 +49,9 @@ struct FrontOptions {
     // A node whose projected size (its cell's diagonal, in pixels) exceeds this branches; a
     // sibling group whose parent projects below it is pruned.
     double projectionThresholdPx = 100.0;
-    // Most points the visible front nodes may hold; 0 = no budget.
+    // Most points the visible front nodes may hold; 0 = no budget. Holds after every
+    // evaluate() (branches that would exceed it wait, the front coarsens when over it) unless
+    // FrontEvaluation::overBudget says nothing more could be pruned.
     std::size_t pointBudget = 4'000'000;
     // CPU time one evaluate() call may spend; 0 = evaluate the whole front every call.
     double cpuBudgetMs = 2.0;

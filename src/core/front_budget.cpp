@@ -28,7 +28,7 @@ std::int64_t childrenVisiblePoints(const Hierarchy& hierarchy, const FrustumPlan
 
 } // namespace
 
-void Front::Impl::collectPrunableGroups() {
+void Front::Impl::collectPrunableGroups(double parentSizeBelowPx) {
     groups.clear();
     ParentCursor parents;
     parents.reset();
@@ -68,7 +68,11 @@ void Front::Impl::collectPrunableGroups() {
                     if (group.parentVisible) {
                         group.pointsFreed -= parent.pointCount;
                     }
-                    groups.push_back(group);
+                    // Groups that free nothing, or look at least as large as what they would
+                    // make room for, are never pruned: leave them out of the sort.
+                    if (group.pointsFreed > 0 && group.parentSizePx < parentSizeBelowPx) {
+                        groups.push_back(group);
+                    }
                 }
             }
         }
@@ -88,7 +92,7 @@ void Front::Impl::applyBudget(const FrontOptions& options, FrontEvaluation& resu
         // Coarsen: prune the smallest groups that free points until the front fits; a pruned
         // group's parent may complete a group one level up, hence the rounds.
         for (int round = 0; round <= hierarchy.maxLevel() && visiblePoints > budget; ++round) {
-            collectPrunableGroups();
+            collectPrunableGroups(std::numeric_limits<double>::infinity());
             operations.clear();
             std::int64_t excess = static_cast<std::int64_t>(visiblePoints - budget);
             for (const PrunableGroup& group : groups) {
@@ -145,7 +149,7 @@ void Front::Impl::applyBudget(const FrontOptions& options, FrontEvaluation& resu
             // where it shows most. Stable from sweep to sweep: the pruned parent is smaller
             // than this node, so it cannot win its place back from this node's children.
             if (!groupsCollected) {
-                collectPrunableGroups();
+                collectPrunableGroups(candidates.front().sizePx);
                 groupsCollected = true;
             }
             std::int64_t freed = 0;

@@ -76,7 +76,9 @@ struct Front::Impl {
 
     // front_budget.cpp
     void applyBudget(const FrontOptions& options, FrontEvaluation& result);
-    void collectPrunableGroups();
+    // Fills `groups` (smallest parent first) with the groups whose prune frees visible points
+    // and whose parent projects below `parentSizeBelowPx`.
+    void collectPrunableGroups(double parentSizeBelowPx);
     void rebuild(std::vector<Rebuild>& operations, FrontEvaluation& result);
 
     std::shared_ptr<const Hierarchy> shared;

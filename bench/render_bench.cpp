@@ -1,0 +1,130 @@
+// render_bench FILE [--size WxH] [--frames N]: GPU frame time of CloudView on this machine's
+// OpenGL (Mesa llvmpipe in CI), on a scripted orbit around the finished hierarchy, for several
+// point budgets. Baseline in the same run: the same frames with a budget of one node (clear,
+// front, readback: what a frame costs without points), so ns_per_point isolates the points.
+// Needs a display (xvfb-run on headless machines).
+#include "bench_timing.hpp"
+#include "cloud_view.hpp"
+#include "hierarchy_builder.hpp"
+#include "morton_sorter.hpp"
+#include "point_reader.hpp"
+
+#include <QApplication>
+#include <QImage>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+using namespace omicron;
+
+namespace {
+
+std::shared_ptr<const Hierarchy> buildHierarchy(const std::string& path) {
+    auto reader = openPointCloud(path);
+    IncrementalMortonSorter sorter(reader->info(), SortOptions{});
+    HierarchyBuilder builder(sorter.cloud(), BuildOptions{});
+    reader->read([&](const PointBatch& batch) { sorter.add(batch); });
+    sorter.sortAndEmit(builder.consumer());
+    builder.finish();
+    builder.wait();
+    return builder.sharedHierarchy();
+}
+
+double percentile(std::vector<double> values, double p) {
+    std::sort(values.begin(), values.end());
+    const auto index = static_cast<std::size_t>(std::lround(p * static_cast<double>(values.size() - 1)));
+    return values[index];
+}
+
+struct PathResult {
+    double frameMsMedian = 0.0, frameMsP95 = 0.0, frontMsMedian = 0.0;
+    double pointsMedian = 0.0;
+};
+
+// One orbit of `frames` frames around the cloud; every frame read back (grabFramebuffer), so
+// the GPU work is finished inside the timing.
+PathResult runPath(CloudView& view, const ViewCamera& start, int frames, std::size_t budget) {
+    RenderSettings settings = view.renderSettings();
+    settings.pointBudget = budget;
+    settings.uploadBudgetBytes = std::size_t{1} << 30; // measure drawing, not upload pacing
+    view.setRenderSettings(settings);
+    std::vector<double> frameMs, frontMs, points;
+    for (int warm = -20; warm < frames; ++warm) {
+        ViewCamera camera = start;
+        camera.orbit(std::max(warm, 0) * 720.0 / frames, 0.0); // one turn over the path
+        view.setCamera(camera);
+        const auto begin = bench::Clock::now();
+        const QImage image = view.grabFramebuffer();
+        const double ms = bench::secondsSince(begin) * 1e3;
+        if (warm >= 0 && !image.isNull()) {
+            frameMs.push_back(ms);
+            frontMs.push_back(view.lastFrameStats().frontMs);
+            points.push_back(static_cast<double>(view.lastFrameStats().pointsDrawn));
+        }
+    }
+    if (frameMs.empty()) {
+        return {};
+    }
+    return {percentile(frameMs, 0.5), percentile(frameMs, 0.95), percentile(frontMs, 0.5),
+            percentile(points, 0.5)};
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2) {
+        std::fprintf(stderr, "usage: render_bench FILE [--size WxH] [--frames N]\n");
+        return 2;
+    }
+    if (std::getenv("DISPLAY") == nullptr && std::getenv("WAYLAND_DISPLAY") == nullptr) {
+        std::fprintf(stderr, "render_bench needs a display (run under xvfb-run)\n");
+        return 2;
+    }
+    int width = 1280, height = 800, frames = 60;
+    for (int i = 2; i + 1 < argc; i += 2) {
+        if (std::strcmp(argv[i], "--size") == 0) {
+            std::sscanf(argv[i + 1], "%dx%d", &width, &height);
+        } else if (std::strcmp(argv[i], "--frames") == 0) {
+            frames = std::max(2, std::atoi(argv[i + 1]));
+        }
+    }
+    const std::string path = argv[1];
+    const auto hierarchy = buildHierarchy(path);
+
+    QApplication app(argc, argv);
+    CloudView view;
+    view.setAttribute(Qt::WA_DontShowOnScreen);
+    view.resize(width, height);
+    view.show();
+    RenderSettings settings;
+    settings.showAxes = false;
+    view.setRenderSettings(settings);
+    view.setHierarchy(hierarchy);
+    (void)view.renderImage(QSize(64, 64)); // bounds and auto-fit
+    const ViewCamera start = view.camera();
+    const char* renderer = "unknown";
+    const std::string glRenderer = view.glRendererName().toStdString();
+    renderer = glRenderer.c_str();
+
+    const PathResult empty = runPath(view, start, frames, 1);
+    std::printf("bench=render phase=baseline_no_points renderer=\"%s\" size=%dx%d frames=%d "
+                "frame_ms_median=%.2f frame_ms_p95=%.2f front_ms_median=%.3f\n",
+                renderer, width, height, frames, empty.frameMsMedian, empty.frameMsP95,
+                empty.frontMsMedian);
+    for (std::size_t budget : {std::size_t{250'000}, std::size_t{1'000'000}, std::size_t{0}}) {
+        const PathResult result = runPath(view, start, frames, budget);
+        const double pointMs = std::max(result.frameMsMedian - empty.frameMsMedian, 0.0);
+        std::printf("bench=render phase=orbit point_budget=%zu size=%dx%d frames=%d "
+                    "points_drawn_median=%.0f frame_ms_median=%.2f frame_ms_p95=%.2f "
+                    "front_ms_median=%.3f ns_per_point=%.1f fps=%.1f\n",
+                    budget, width, height, frames, result.pointsMedian, result.frameMsMedian,
+                    result.frameMsP95, result.frontMsMedian,
+                    result.pointsMedian > 0 ? pointMs * 1e6 / result.pointsMedian : 0.0,
+                    result.frameMsMedian > 0 ? 1000.0 / result.frameMsMedian : 0.0);
+    }
+    return 0;
+}

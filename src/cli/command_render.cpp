@@ -1,0 +1,193 @@
+// omicron-cli render: the full pipeline (unsorted cloud or .oms -> builder), then one image of
+// the finished hierarchy through the same CloudView the application shows, without a visible
+// window. Needs a display for the OpenGL context (under CI: xvfb-run).
+#include "atomic_file_writer.hpp"
+#include "cli_args.hpp"
+#include "cloud_view.hpp"
+#include "commands.hpp"
+#include "hierarchy_builder.hpp"
+#include "input_error.hpp"
+#include "oms_reader.hpp"
+#include "point_reader.hpp"
+
+#include <QApplication>
+#include <QImage>
+#include <cstdio>
+#include <cstdlib>
+#include <tbb/global_control.h>
+
+namespace omicron::cli {
+
+namespace {
+
+struct CameraChoice {
+    const char* name;
+    bool fit;
+    StandardView view;
+};
+
+constexpr CameraChoice kCameras[] = {
+    {"fit", true, StandardView::Iso},       {"iso", false, StandardView::Iso},
+    {"top", false, StandardView::Top},       {"bottom", false, StandardView::Bottom},
+    {"front", false, StandardView::Front},   {"back", false, StandardView::Back},
+    {"left", false, StandardView::Left},     {"right", false, StandardView::Right},
+};
+
+constexpr std::pair<const char*, ColorMode> kColors[] = {
+    {"rgb", ColorMode::Rgb},     {"normal", ColorMode::Normal}, {"height", ColorMode::Height},
+    {"intensity", ColorMode::Intensity}, {"level", ColorMode::Level}, {"age", ColorMode::BuildAge},
+};
+
+QSize parseSize(const std::string& text) {
+    const auto x = text.find('x');
+    if (x == std::string::npos) {
+        throw UsageError("--size takes WIDTHxHEIGHT, e.g. 1280x800, found '" + text + "'");
+    }
+    const auto width = parseInteger(text.substr(0, x), "size", 16, 8192);
+    const auto height = parseInteger(text.substr(x + 1), "size", 16, 8192);
+    return QSize(static_cast<int>(width), static_cast<int>(height));
+}
+
+std::shared_ptr<const Hierarchy> buildHierarchy(const std::string& path, const BuildOptions& options) {
+    if (isOmsFile(path)) {
+        OmsReader reader(path);
+        HierarchyBuilder builder(reader.cloud(), options);
+        reader.read(builder.consumer());
+        builder.finish();
+        builder.wait();
+        return builder.sharedHierarchy();
+    }
+    auto reader = openPointCloud(path);
+    IncrementalMortonSorter sorter(reader->info(), SortOptions{});
+    HierarchyBuilder builder(sorter.cloud(), options);
+    reader->read([&](const PointBatch& batch) { sorter.add(batch); });
+    sorter.sortAndEmit(builder.consumer());
+    builder.finish();
+    builder.wait();
+    return builder.sharedHierarchy();
+}
+
+int runRender(const std::vector<std::string>& args) {
+    const ParsedArgs parsed = parseArgs(args, {{"camera", true},
+                                               {"size", true},
+                                               {"mode", true},
+                                               {"color", true},
+                                               {"depth", true},
+                                               {"threshold", true},
+                                               {"threads", true}});
+    if (parsed.help) {
+        printCommandHelp(renderCommand());
+        return 0;
+    }
+    if (parsed.positionals.size() != 2) {
+        throw UsageError("expected IN and OUT.png, found " +
+                         std::to_string(parsed.positionals.size()) + " arguments");
+    }
+    const CameraChoice* camera = &kCameras[0];
+    if (const auto name = parsed.value("camera")) {
+        camera = nullptr;
+        for (const CameraChoice& choice : kCameras) {
+            camera = *name == choice.name ? &choice : camera;
+        }
+        if (camera == nullptr) {
+            throw UsageError("--camera takes fit, iso, top, bottom, front, back, left or right, "
+                             "found '" + *name + "'");
+        }
+    }
+    RenderSettings settings;
+    settings.showAxes = false;
+    settings.showCutBoundary = false;
+    settings.pointBudget = 0; // an image of everything the threshold asks for
+    if (const auto mode = parsed.value("mode")) {
+        if (*mode != "points" && *mode != "splats") {
+            throw UsageError("--mode takes points or splats, found '" + *mode + "'");
+        }
+        settings.mode = *mode == "splats" ? RenderMode::Splats : RenderMode::Points;
+    }
+    if (const auto color = parsed.value("color")) {
+        bool known = false;
+        for (const auto& [name, value] : kColors) {
+            if (*color == name) {
+                settings.color = value;
+                known = true;
+            }
+        }
+        if (!known) {
+            throw UsageError("--color takes rgb, normal, height, intensity, level or age, found '" +
+                             *color + "'");
+        }
+    }
+    if (const auto threshold = parsed.value("threshold")) {
+        settings.projectionThresholdPx =
+            static_cast<double>(parseInteger(*threshold, "threshold", 1, 100000));
+    }
+    const QSize size = parseSize(parsed.value("size").value_or("1280x800"));
+    BuildOptions options;
+    if (const auto depth = parsed.value("depth")) {
+        options.maxLevel = static_cast<int>(parseInteger(*depth, "depth", 1, morton::kMaxLevel));
+    }
+    const int threads = threadsOption(parsed);
+    options.threads = threads;
+    tbb::global_control threadLimit(tbb::global_control::max_allowed_parallelism,
+                                    static_cast<std::size_t>(threads));
+    const std::string& inPath = parsed.positionals[0];
+    const std::string& outPath = parsed.positionals[1];
+
+    if (std::getenv("DISPLAY") == nullptr && std::getenv("WAYLAND_DISPLAY") == nullptr) {
+        throw OutputError(outPath + ": rendering needs a display for its OpenGL context; none is "
+                                    "set (headless machines: run under xvfb-run)");
+    }
+    const auto hierarchy = buildHierarchy(inPath, options);
+
+    int argc = 1;
+    char programName[] = "omicron-cli";
+    char* argv[] = {programName, nullptr};
+    QApplication app(argc, argv);
+    CloudView view;
+    view.setRenderSettings(settings);
+    view.setHierarchy(hierarchy);
+    if (!camera->fit) {
+        view.setStandardView(camera->view);
+    }
+    const QImage image = view.renderImage(size);
+    if (image.isNull()) {
+        throw OutputError(outPath + ": no OpenGL 3.3 context: " + view.glErrorString().toStdString());
+    }
+    const std::string temporary = outPath + ".partial.png";
+    if (!image.save(QString::fromStdString(temporary), "PNG") ||
+        std::rename(temporary.c_str(), outPath.c_str()) != 0) {
+        std::remove(temporary.c_str());
+        throw OutputError(outPath + ": cannot write the image");
+    }
+    const FrameStats stats = view.lastFrameStats();
+    std::printf("rendered %zu of %zu points (%zu nodes) at %dx%d into %s\n", stats.pointsDrawn,
+                stats.pointsTotal, stats.nodesDrawn, size.width(), size.height(), outPath.c_str());
+    return 0;
+}
+
+} // namespace
+
+const Command& renderCommand() {
+    static const Command command{
+        "render", "build a cloud's hierarchy and save an image of it (needs a display)",
+        "render IN OUT.png [--camera fit|iso|top|bottom|front|back|left|right] [--size WxH] "
+        "[--mode points|splats] [--color rgb|normal|height|intensity|level|age] [--depth N] "
+        "[--threshold PX] [--threads T]",
+        "Runs the pipeline (an unsorted cloud is sorted first; a .oms file is streamed), waits\n"
+        "for the hierarchy, and renders it with the viewer's CloudView off screen: the front\n"
+        "converged at the default projection threshold, no point budget.\n\n"
+        "  --camera   fit (default: the cloud framed from above at an angle), or a standard view\n"
+        "             (top looks down z; front looks along +y)\n"
+        "  --size     image size in pixels (default 1280x800)\n"
+        "  --mode     points (default) or splats (three-pass surface splatting)\n"
+        "  --color    rgb (default; height where the cloud has no colour), normal, height,\n"
+        "             intensity, level (hierarchy level of each node), age (build order)\n"
+        "  --depth    hierarchy depth (default 7)\n"
+        "  --threshold  front projection threshold in pixels: a node whose cell projects larger\n"
+        "             is replaced by its children (default: the viewer's)\n\n"
+        "The OpenGL context needs a display: on a headless machine run it under xvfb-run.\n",
+        runRender};
+    return command;
+}
+
+} // namespace omicron::cli

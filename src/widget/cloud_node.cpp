@@ -1,0 +1,390 @@
+#include "cloud_node.hpp"
+
+#include "hierarchy.hpp"
+#include "shader_library.hpp"
+#include "view_camera.hpp"
+
+#include <QElapsedTimer>
+#include <algorithm>
+#include <glm/gtc/type_ptr.hpp>
+#include <cmath>
+
+namespace omicron {
+
+namespace {
+
+// Screen-size limits of one point: at least a pixel, at most what every driver supports.
+constexpr float kMinPointPx = 1.0f;
+constexpr float kMaxPointPx = 64.0f;
+// Splat visibility pass: splats pushed back by this many radii so that overlapping splats of
+// one surface pass the depth test of the accumulation pass and blend.
+constexpr float kSplatDepthOffsetRadii = 1.0f;
+// Screenshots: most front evaluations spent converging before the image is taken.
+constexpr int kMaxSettleEvaluations = 256;
+
+glm::vec3 levelColor(int level) {
+    // Hues spaced by the golden angle: neighbouring levels never look alike.
+    const float hue = std::fmod(static_cast<float>(level) * 0.618034f + 0.1f, 1.0f) * 6.0f;
+    const float x = 1.0f - std::fabs(std::fmod(hue, 2.0f) - 1.0f);
+    const int sector = static_cast<int>(hue);
+    const glm::vec3 table[6] = {{1, x, 0}, {x, 1, 0}, {0, 1, x}, {0, x, 1}, {x, 0, 1}, {1, 0, x}};
+    return glm::vec3(0.25f) + table[std::clamp(sector, 0, 5)] * 0.75f;
+}
+
+} // namespace
+
+CloudNode::CloudNode() = default;
+CloudNode::~CloudNode() = default;
+
+void CloudNode::setHierarchy(std::shared_ptr<const Hierarchy> hierarchy) {
+    m_hierarchy = std::move(hierarchy);
+    m_front = m_hierarchy ? std::make_unique<Front>(m_hierarchy) : nullptr;
+    m_hierarchyChanged = true;
+    m_drawList.clear();
+    m_boundsScanned = 0;
+    m_boundsMin = glm::dvec3(1.0);
+    m_boundsMax = glm::dvec3(0.0);
+}
+
+void CloudNode::setPreview(std::vector<PointVertex> vertices) {
+    m_previewVertices = std::move(vertices);
+    if (m_previewVertices.empty()) {
+        m_previewCount = 0;
+    }
+    if (!m_hierarchy || m_boundsScanned == 0) {
+        for (const PointVertex& v : m_previewVertices) {
+            m_boundsMin = glm::min(m_boundsMin, glm::dvec3(v.x, v.y, v.z));
+            m_boundsMax = glm::max(m_boundsMax, glm::dvec3(v.x, v.y, v.z));
+        }
+    }
+}
+
+void CloudNode::updateBounds(std::size_t maxPoints) {
+    if (!m_hierarchy) {
+        return;
+    }
+    const SortedCloud& cloud = m_hierarchy->cloud();
+    const std::size_t published = cloud.sortedEnd();
+    if (m_boundsScanned == 0 && published > 0) {
+        // The preview's bounds were provisional; the cloud's own points replace them.
+        m_boundsMin = glm::dvec3(1.0);
+        m_boundsMax = glm::dvec3(0.0);
+    }
+    const std::size_t end = std::min(published, m_boundsScanned + maxPoints);
+    const auto positions = cloud.positions();
+    glm::vec3 low(m_boundsMin), high(m_boundsMax);
+    for (std::size_t i = m_boundsScanned; i < end; ++i) {
+        low = glm::min(low, positions[i]);
+        high = glm::max(high, positions[i]);
+    }
+    m_boundsMin = glm::dvec3(low);
+    m_boundsMax = glm::dvec3(high);
+    m_boundsScanned = end;
+}
+
+bool CloudNode::boundsPending() const {
+    return m_hierarchy && m_boundsScanned < m_hierarchy->cloud().sortedEnd();
+}
+
+void CloudNode::initializeGL(QOpenGLExtraFunctions& gl) {
+    m_pointsProgram = buildShaderProgram({"points.vert", "points.frag", {"color.glsl"}});
+    m_visibilityProgram = buildShaderProgram(
+        {"points.vert", "splat_visibility.frag", {"color.glsl"}, {"splat_disc.glsl"}});
+    m_accumulateProgram = buildShaderProgram(
+        {"points.vert", "splat_accumulate.frag", {"color.glsl"}, {"splat_disc.glsl"}});
+    m_normalizeProgram = buildShaderProgram({"fullscreen.vert", "splat_normalize.frag"});
+    gl.glGenVertexArrays(1, &m_vao);
+    m_initialized = true;
+    // A new context: every buffer has to be uploaded again.
+    m_cache.abandon();
+    m_previewVbo = 0;
+}
+
+void CloudNode::releaseGL(QOpenGLExtraFunctions& gl) {
+    if (!m_initialized) {
+        return;
+    }
+    m_cache.clear(gl);
+    if (m_previewVbo != 0) {
+        gl.glDeleteBuffers(1, &m_previewVbo);
+        m_previewVbo = 0;
+    }
+    m_splatTarget.release(gl);
+    gl.glDeleteVertexArrays(1, &m_vao);
+    m_vao = 0;
+    m_pointsProgram.reset();
+    m_visibilityProgram.reset();
+    m_accumulateProgram.reset();
+    m_normalizeProgram.reset();
+    m_initialized = false;
+}
+
+void CloudNode::evaluateFront(RenderContext& context) {
+    const RenderSettings& settings = *context.settings;
+    FrontCamera camera;
+    camera.viewProjection = context.projection * context.view;
+    camera.eye = context.camera->eye();
+    camera.pixelsPerUnitAtUnitDistance = context.camera->pixelsPerUnitAtUnitDistance(context.heightPx);
+    FrontOptions options;
+    options.projectionThresholdPx = settings.projectionThresholdPx;
+    options.pointBudget = settings.pointBudget;
+    options.cpuBudgetMs = context.settle ? 0.0 : settings.frontBudgetMs;
+
+    QElapsedTimer timer;
+    timer.start();
+    int evaluations = 0;
+    while (true) {
+        const FrontEvaluation evaluation = m_front->evaluate(camera, options);
+        ++evaluations;
+        const bool changed = evaluation.placeholdersInserted + evaluation.substituted +
+                                 evaluation.branched + evaluation.pruned > 0;
+        if (!context.settle || (!changed && evaluation.finishedSweep) ||
+            evaluations >= kMaxSettleEvaluations) {
+            break;
+        }
+    }
+    context.stats->frontMs = static_cast<double>(timer.nsecsElapsed()) * 1e-6;
+    context.stats->frontNodes = m_front->entries().size();
+    context.stats->placeholders = m_front->placeholderCount();
+}
+
+void CloudNode::collectDrawList(RenderContext& context) {
+    m_drawList.clear();
+    const double capacity = std::max<double>(1.0, static_cast<double>(m_hierarchy->cloud().capacity()));
+    for (const FrontEntry& entry : m_front->entries()) {
+        if (entry.placeholder || !entry.visible) {
+            continue;
+        }
+        const int level = entry.level();
+        const OctreeNode& node = m_hierarchy->node(level, entry.index);
+        if (node.pointCount == 0) {
+            continue;
+        }
+        // Input arrives in Morton order, so where a node's points start in the sorted cloud
+        // is when the sweep reached it: the build-age colour shows the oblique sweep.
+        const float age = static_cast<float>(node.coveredBegin / capacity);
+        m_drawList.push_back({NodeBufferCache::key(level, entry.index), level, entry.index, age});
+    }
+
+    // Upload what is missing, coarse nodes first (they cover the most screen per byte),
+    // within the per-frame budget.
+    std::vector<const DrawItem*> missing;
+    for (const DrawItem& item : m_drawList) {
+        if (m_cache.use(item.key, m_frame) == nullptr) {
+            missing.push_back(&item);
+        }
+    }
+    std::stable_sort(missing.begin(), missing.end(),
+                     [](const DrawItem* a, const DrawItem* b) { return a->level < b->level; });
+    std::size_t uploadedBytes = 0;
+    for (const DrawItem* item : missing) {
+        if (!context.settle && uploadedBytes >= context.settings->uploadBudgetBytes) {
+            break;
+        }
+        packNodeVertices(*m_hierarchy, m_hierarchy->node(item->level, item->index), m_scratch);
+        uploadedBytes += m_cache.upload(*context.gl, item->key, m_scratch, m_frame).bytes;
+        ++context.stats->uploads;
+    }
+}
+
+void CloudNode::uploadPreview(QOpenGLExtraFunctions& gl) {
+    if (m_previewVertices.empty()) {
+        return;
+    }
+    if (m_previewVbo == 0) {
+        gl.glGenBuffers(1, &m_previewVbo);
+    }
+    gl.glBindBuffer(GL_ARRAY_BUFFER, m_previewVbo);
+    gl.glBufferData(GL_ARRAY_BUFFER,
+                    static_cast<GLsizeiptr>(m_previewVertices.size() * sizeof(PointVertex)),
+                    m_previewVertices.data(), GL_DYNAMIC_DRAW);
+    gl.glBindBuffer(GL_ARRAY_BUFFER, 0);
+    m_previewCount = static_cast<int>(m_previewVertices.size());
+    m_previewVertices.clear();
+}
+
+int CloudNode::effectiveColorMode(const RenderSettings& settings) const {
+    ColorMode mode = settings.color;
+    if (m_hierarchy) {
+        const AttributeSet attributes = m_hierarchy->cloud().attributes();
+        if ((mode == ColorMode::Rgb && !attributes.has(Attribute::Color)) ||
+            (mode == ColorMode::Intensity && !attributes.has(Attribute::Intensity))) {
+            mode = ColorMode::Height; // what Potree and CloudCompare show for plain xyz
+        }
+    }
+    return static_cast<int>(mode);
+}
+
+void CloudNode::setCommonUniforms(QOpenGLShaderProgram& program, const RenderContext& context,
+                                  float depthOffset) {
+    const RenderSettings& settings = *context.settings;
+    program.setUniformValue("u_view", QMatrix4x4(glm::value_ptr(glm::mat4(context.view))).transposed());
+    program.setUniformValue("u_projection",
+                            QMatrix4x4(glm::value_ptr(glm::mat4(context.projection))).transposed());
+    program.setUniformValue(
+        "u_pixelsPerUnit",
+        static_cast<float>(context.camera->pixelsPerUnitAtUnitDistance(context.heightPx)));
+    program.setUniformValue("u_sizeScale", settings.pointSizeScale);
+    program.setUniformValue("u_minPointPx", kMinPointPx);
+    program.setUniformValue("u_maxPointPx", kMaxPointPx);
+    program.setUniformValue("u_depthOffset", depthOffset);
+    program.setUniformValue("u_colorMode", effectiveColorMode(settings));
+    const float low = hasBounds() ? static_cast<float>(m_boundsMin.z) : 0.0f;
+    const float high = hasBounds() ? static_cast<float>(m_boundsMax.z) : 1.0f;
+    program.setUniformValue("u_heightRange", QVector2D(low, high));
+    program.setUniformValue("u_levelColor", QVector3D(1, 1, 1));
+    program.setUniformValue("u_buildAge", 0.0f);
+}
+
+void CloudNode::bindVertexLayout(QOpenGLExtraFunctions& gl, unsigned vbo) {
+    gl.glBindBuffer(GL_ARRAY_BUFFER, vbo);
+    const auto stride = static_cast<GLsizei>(sizeof(PointVertex));
+    gl.glEnableVertexAttribArray(0);
+    gl.glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(0));
+    gl.glEnableVertexAttribArray(1);
+    gl.glVertexAttribPointer(1, 4, GL_UNSIGNED_BYTE, GL_TRUE, stride, reinterpret_cast<void*>(12));
+    gl.glEnableVertexAttribArray(2);
+    gl.glVertexAttribPointer(2, 4, GL_INT_2_10_10_10_REV, GL_TRUE, stride,
+                             reinterpret_cast<void*>(16));
+    gl.glEnableVertexAttribArray(3);
+    gl.glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(20));
+}
+
+void CloudNode::drawItems(RenderContext& context, QOpenGLShaderProgram& program) {
+    QOpenGLExtraFunctions& gl = *context.gl;
+    const int levelLocation = program.uniformLocation("u_levelColor");
+    const int ageLocation = program.uniformLocation("u_buildAge");
+    for (const DrawItem& item : m_drawList) {
+        const NodeBufferCache::Buffer* buffer = m_cache.use(item.key, m_frame);
+        if (buffer == nullptr) {
+            continue; // not uploaded yet (per-frame budget)
+        }
+        const glm::vec3 color = levelColor(item.level);
+        program.setUniformValue(levelLocation, QVector3D(color.x, color.y, color.z));
+        program.setUniformValue(ageLocation, item.buildAge);
+        bindVertexLayout(gl, buffer->vbo);
+        gl.glDrawArrays(GL_POINTS, 0, buffer->pointCount);
+    }
+}
+
+void CloudNode::drawPreview(RenderContext& context) {
+    if (m_previewVbo == 0 || m_previewCount == 0) {
+        return;
+    }
+    bindVertexLayout(*context.gl, m_previewVbo);
+    context.gl->glDrawArrays(GL_POINTS, 0, m_previewCount);
+}
+
+void CloudNode::drawPoints(RenderContext& context) {
+    QOpenGLExtraFunctions& gl = *context.gl;
+    gl.glBindFramebuffer(GL_FRAMEBUFFER, context.targetFramebuffer);
+    gl.glEnable(GL_DEPTH_TEST);
+    gl.glDepthFunc(GL_LESS);
+    gl.glDepthMask(GL_TRUE);
+    m_pointsProgram->bind();
+    setCommonUniforms(*m_pointsProgram, context, 0.0f);
+    drawItems(context, *m_pointsProgram);
+    if (m_drawList.empty()) {
+        drawPreview(context);
+    }
+    m_pointsProgram->release();
+}
+
+void CloudNode::drawSplats(RenderContext& context) {
+    QOpenGLExtraFunctions& gl = *context.gl;
+    if (!m_splatTarget.ensureSize(gl, context.widthPx, context.heightPx)) {
+        drawPoints(context); // no float render target on this driver: points are still right
+        return;
+    }
+    // Pass 1: visibility (depth of the nearest surface, pushed back by a splat radius).
+    gl.glBindFramebuffer(GL_FRAMEBUFFER, m_splatTarget.framebuffer());
+    gl.glViewport(0, 0, context.widthPx, context.heightPx);
+    gl.glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+    gl.glClearDepthf(1.0f);
+    gl.glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    gl.glEnable(GL_DEPTH_TEST);
+    gl.glDepthFunc(GL_LESS);
+    gl.glDepthMask(GL_TRUE);
+    gl.glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    m_visibilityProgram->bind();
+    setCommonUniforms(*m_visibilityProgram, context, kSplatDepthOffsetRadii);
+    drawItems(context, *m_visibilityProgram);
+    if (m_drawList.empty()) {
+        drawPreview(context);
+    }
+
+    // Pass 2: accumulation of Gaussian-weighted colours of the splats on that surface.
+    gl.glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    gl.glDepthMask(GL_FALSE);
+    gl.glDepthFunc(GL_LEQUAL);
+    gl.glEnable(GL_BLEND);
+    gl.glBlendFunc(GL_ONE, GL_ONE);
+    m_accumulateProgram->bind();
+    setCommonUniforms(*m_accumulateProgram, context, 0.0f);
+    drawItems(context, *m_accumulateProgram);
+    if (m_drawList.empty()) {
+        drawPreview(context);
+    }
+    gl.glDisable(GL_BLEND);
+
+    // Pass 3: normalisation into the frame, with the surface's depth.
+    gl.glBindFramebuffer(GL_FRAMEBUFFER, context.targetFramebuffer);
+    gl.glDepthMask(GL_TRUE);
+    gl.glDepthFunc(GL_ALWAYS);
+    m_normalizeProgram->bind();
+    gl.glActiveTexture(GL_TEXTURE0);
+    gl.glBindTexture(GL_TEXTURE_2D, m_splatTarget.accumulationTexture());
+    gl.glActiveTexture(GL_TEXTURE1);
+    gl.glBindTexture(GL_TEXTURE_2D, m_splatTarget.depthTexture());
+    m_normalizeProgram->setUniformValue("u_accumulation", 0);
+    m_normalizeProgram->setUniformValue("u_depth", 1);
+    gl.glDrawArrays(GL_TRIANGLES, 0, 3);
+    gl.glBindTexture(GL_TEXTURE_2D, 0);
+    gl.glActiveTexture(GL_TEXTURE0);
+    gl.glBindTexture(GL_TEXTURE_2D, 0);
+    gl.glDepthFunc(GL_LESS);
+    m_normalizeProgram->release();
+}
+
+void CloudNode::render(RenderContext& context) {
+    QOpenGLExtraFunctions& gl = *context.gl;
+    ++m_frame;
+    if (m_hierarchyChanged) {
+        m_cache.clear(gl);
+        m_hierarchyChanged = false;
+    }
+    uploadPreview(gl);
+
+    m_drawList.clear();
+    if (m_front) {
+        evaluateFront(context);
+        collectDrawList(context);
+        context.stats->pointsTotal = m_hierarchy->cloud().capacity();
+    }
+
+    gl.glBindVertexArray(m_vao);
+    gl.glEnable(GL_PROGRAM_POINT_SIZE);
+    if (context.settings->mode == RenderMode::Splats) {
+        drawSplats(context);
+    } else {
+        drawPoints(context);
+    }
+    if (m_drawList.empty()) {
+        context.stats->showingPreview = m_previewCount > 0;
+        context.stats->pointsDrawn = static_cast<std::size_t>(m_previewCount);
+    } else {
+        for (const DrawItem& item : m_drawList) {
+            if (const auto* buffer = m_cache.use(item.key, m_frame)) {
+                context.stats->pointsDrawn += static_cast<std::size_t>(buffer->pointCount);
+                ++context.stats->nodesDrawn;
+            }
+        }
+    }
+    gl.glBindVertexArray(0);
+    gl.glBindBuffer(GL_ARRAY_BUFFER, 0);
+
+    m_cache.evictTo(gl, context.settings->gpuMemoryBudgetBytes, m_frame);
+    context.stats->gpuBytes = m_cache.bytesResident();
+}
+
+} // namespace omicron

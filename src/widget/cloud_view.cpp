@@ -1,0 +1,477 @@
+#include "cloud_view.hpp"
+
+#include "axis_gizmo_node.hpp"
+#include "cloud_node.hpp"
+#include "hierarchy.hpp"
+#include "morton_sorter.hpp"
+#include "overlay_node.hpp"
+#include "view_camera.hpp"
+
+#include <QElapsedTimer>
+#include <QKeyEvent>
+#include <QMouseEvent>
+#include <QOpenGLContext>
+#include <QOpenGLFramebufferObject>
+#include <QSet>
+#include <QTimer>
+#include <QWheelEvent>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <glm/gtc/matrix_inverse.hpp>
+#include <optional>
+
+namespace omicron {
+
+namespace {
+
+constexpr int kFrameIntervalMs = 16; // the repaint and fly timer: ~60 Hz
+constexpr double kWheelZoomPerNotch = 0.85;
+constexpr std::size_t kBoundsPointsPerFrame = std::size_t{4} << 20;
+constexpr float kBackground[3] = {0.11f, 0.12f, 0.14f}; // dark slate, as point viewers use
+
+} // namespace
+
+class CloudViewPrivate {
+public:
+    SceneGraph scene;
+    CloudNode* cloud = nullptr;
+    ViewCamera camera;
+    RenderSettings settings;
+    FrameStats lastStats;
+    bool autoFit = true; // frame the cloud until the user moves the camera
+    bool glReady = false;
+    QString glError;
+    QString glRenderer;
+    bool flyMode = false;
+    QSet<int> flyKeys;
+    QTimer frameTimer;
+    QElapsedTimer flyClock;
+    QElapsedTimer fpsClock;
+    int framesThisSecond = 0;
+    double fps = 0.0;
+    QPoint lastMouse;
+    Qt::MouseButtons dragButtons;
+    QMetaObject::Connection contextConnection;
+
+    CloudViewPrivate() {
+        auto cloudNode = std::make_unique<CloudNode>();
+        cloud = scene.add(std::move(cloudNode));
+        scene.add(std::make_unique<OverlayNode>(*cloud));
+        scene.add(std::make_unique<AxisGizmoNode>());
+    }
+
+    // Frames keep coming while anything can still change without user input.
+    bool needsMoreFrames() const {
+        if (!flyKeys.isEmpty()) {
+            return true;
+        }
+        if (const auto& hierarchy = cloud->hierarchy()) {
+            // Still building, leaves waiting for substitution, uploads cut by the budget, a
+            // front sweep cut by its time budget, or points not yet in the bounds.
+            return !hierarchy->publishedCut().complete || lastStats.placeholders > 0 ||
+                   lastStats.uploads > 0 || lastStats.frontMs >= settings.frontBudgetMs * 0.9 ||
+                   cloud->boundsPending();
+        }
+        return false; // a preview changes only through setPreview(), which repaints
+    }
+
+    // Until the user navigates, the camera keeps framing the cloud as its known bounds grow
+    // (a build publishes the cloud in Morton order, one region after another).
+    void applyAutoFit() {
+        if (autoFit && cloud->hasBounds()) {
+            camera.setSceneBox(cloud->boundsMin(), cloud->boundsMax());
+            camera.fit();
+        }
+    }
+};
+
+CloudView::CloudView(QWidget* parent) : QOpenGLWidget(parent), d(std::make_unique<CloudViewPrivate>()) {
+    qRegisterMetaType<omicron::FrameStats>();
+    qRegisterMetaType<omicron::RenderSettings>();
+    QSurfaceFormat surfaceFormat = format();
+    surfaceFormat.setVersion(3, 3);
+    surfaceFormat.setProfile(QSurfaceFormat::CoreProfile);
+    surfaceFormat.setDepthBufferSize(24);
+    surfaceFormat.setSamples(0); // the depth under the cursor is read back for picking
+    setFormat(surfaceFormat);
+    setFocusPolicy(Qt::StrongFocus);
+    setMinimumSize(160, 120);
+    d->frameTimer.setInterval(kFrameIntervalMs);
+    connect(&d->frameTimer, &QTimer::timeout, this, [this] {
+        if (!d->flyKeys.isEmpty()) {
+            const double seconds = std::min(d->flyClock.restart() * 1e-3, 0.1);
+            glm::dvec3 direction(0.0);
+            direction.z += d->flyKeys.contains(Qt::Key_W) ? 1.0 : 0.0;
+            direction.z -= d->flyKeys.contains(Qt::Key_S) ? 1.0 : 0.0;
+            direction.x += d->flyKeys.contains(Qt::Key_D) ? 1.0 : 0.0;
+            direction.x -= d->flyKeys.contains(Qt::Key_A) ? 1.0 : 0.0;
+            direction.y += d->flyKeys.contains(Qt::Key_E) ? 1.0 : 0.0;
+            direction.y -= d->flyKeys.contains(Qt::Key_Q) ? 1.0 : 0.0;
+            d->camera.fly(direction, seconds);
+        }
+        update();
+    });
+    d->fpsClock.start();
+}
+
+CloudView::~CloudView() {
+    // The base class destroys the context after `d` is gone: nothing may react to it then.
+    disconnect(d->contextConnection);
+    if (d->glReady && context() != nullptr) {
+        makeCurrent();
+        d->scene.releaseGL(*context()->extraFunctions());
+        doneCurrent();
+    }
+}
+
+void CloudView::setHierarchy(std::shared_ptr<const Hierarchy> hierarchy) {
+    const bool first = d->cloud->hierarchy() == nullptr && hierarchy != nullptr;
+    d->cloud->setHierarchy(std::move(hierarchy));
+    if (first) {
+        d->autoFit = true;
+    }
+    update();
+}
+
+std::shared_ptr<const Hierarchy> CloudView::hierarchy() const { return d->cloud->hierarchy(); }
+
+void CloudView::setPreview(const PreviewSample& preview, const CubeTransform& cube) {
+    (void)cube; // preview positions are already in the unit cube of `cube`
+    std::vector<PointVertex> vertices(preview.positions.size());
+    glm::vec3 low(1.0f), high(0.0f);
+    for (const glm::vec3& p : preview.positions) {
+        low = glm::min(low, p);
+        high = glm::max(high, p);
+    }
+    // A preview point stands for pointsSeen / samples input points: size its splat so the
+    // sample covers the area the cloud would (a surface of the box's two largest extents).
+    const glm::vec3 extent = glm::max(high - low, glm::vec3(0.0f));
+    const float area = std::max({extent.x * extent.y, extent.x * extent.z, extent.y * extent.z, 1e-12f});
+    const float radius =
+        vertices.empty() ? 0.0f : 0.6f * std::sqrt(area / static_cast<float>(vertices.size()));
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+        PointVertex& v = vertices[i];
+        v.x = preview.positions[i].x;
+        v.y = preview.positions[i].y;
+        v.z = preview.positions[i].z;
+        if (i < preview.colors.size()) {
+            v.r = preview.colors[i].r;
+            v.g = preview.colors[i].g;
+            v.b = preview.colors[i].b;
+        } else {
+            v.r = v.g = v.b = 200;
+        }
+        v.radius = radius;
+    }
+    d->cloud->setPreview(std::move(vertices));
+    update();
+}
+
+void CloudView::clearPreview() {
+    d->cloud->setPreview({});
+    update();
+}
+
+RenderSettings CloudView::renderSettings() const { return d->settings; }
+
+void CloudView::setRenderSettings(const RenderSettings& settings) {
+    if (settings == d->settings) {
+        return;
+    }
+    d->settings = settings;
+    emit renderSettingsChanged(settings);
+    update();
+}
+
+ViewCamera CloudView::camera() const { return d->camera; }
+
+void CloudView::setCamera(const ViewCamera& camera) {
+    d->camera = camera;
+    d->autoFit = false;
+    update();
+}
+
+void CloudView::fitToCloud() {
+    d->autoFit = true;
+    d->applyAutoFit();
+    update();
+}
+
+void CloudView::setStandardView(StandardView view) {
+    if (d->cloud->hasBounds()) {
+        d->camera.setSceneBox(d->cloud->boundsMin(), d->cloud->boundsMax());
+    }
+    d->camera.setStandardView(view);
+    d->autoFit = true; // the box may still grow: keep framing it from this direction
+    update();
+}
+
+void CloudView::setFlyMode(bool on) {
+    if (on == d->flyMode) {
+        return;
+    }
+    d->flyMode = on;
+    emit flyModeChanged(on);
+}
+
+bool CloudView::flyMode() const { return d->flyMode; }
+
+FrameStats CloudView::lastFrameStats() const { return d->lastStats; }
+
+QString CloudView::glErrorString() const { return d->glError; }
+
+QString CloudView::glRendererName() const { return d->glRenderer; }
+
+void CloudView::initializeGL() {
+    QOpenGLContext* glContext = context();
+    d->glRenderer = QString::fromLatin1(
+        reinterpret_cast<const char*>(glContext->functions()->glGetString(GL_RENDERER)));
+    const QSurfaceFormat actual = glContext->format();
+    if (actual.majorVersion() < 3 || (actual.majorVersion() == 3 && actual.minorVersion() < 3)) {
+        d->glError = QStringLiteral("OpenGL 3.3 or newer is needed; this context has %1.%2")
+                         .arg(actual.majorVersion())
+                         .arg(actual.minorVersion());
+        qWarning("omicron::CloudView: %s", qPrintable(d->glError));
+        return;
+    }
+    try {
+        d->scene.initializeGL(*glContext->extraFunctions());
+        d->glReady = true;
+    } catch (const std::exception& error) {
+        d->glError = QString::fromStdString(error.what());
+        qWarning("omicron::CloudView: %s", qPrintable(d->glError));
+        return;
+    }
+    // GL resources belong to this context: free them while it still exists (the widget may
+    // be re-parented, which gives it a new context and a new initializeGL()).
+    disconnect(d->contextConnection);
+    d->contextConnection = connect(glContext, &QOpenGLContext::aboutToBeDestroyed, this, [this] {
+        if (d->glReady) {
+            makeCurrent();
+            d->scene.releaseGL(*context()->extraFunctions());
+            d->glReady = false;
+            doneCurrent();
+        }
+    });
+    d->frameTimer.start();
+}
+
+void CloudView::resizeGL(int, int) {}
+
+FrameStats CloudView::renderFrame(unsigned framebuffer, int widthPx, int heightPx, bool settle) {
+    QElapsedTimer timer;
+    timer.start();
+    FrameStats stats;
+    QOpenGLExtraFunctions& gl = *context()->extraFunctions();
+    gl.glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    gl.glViewport(0, 0, widthPx, heightPx);
+    gl.glClearColor(kBackground[0], kBackground[1], kBackground[2], 1.0f);
+    gl.glClearDepthf(1.0f);
+    gl.glDepthMask(GL_TRUE);
+    gl.glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    if (!d->glReady) {
+        return stats;
+    }
+    // Bounded work per frame while a build publishes points; everything for a screenshot.
+    d->cloud->updateBounds(settle ? std::numeric_limits<std::size_t>::max() : kBoundsPointsPerFrame);
+    d->applyAutoFit();
+    if (d->cloud->hasBounds()) {
+        d->camera.setSceneBox(d->cloud->boundsMin(), d->cloud->boundsMax());
+    }
+
+    RenderContext renderContext;
+    renderContext.gl = &gl;
+    renderContext.camera = &d->camera;
+    renderContext.settings = &d->settings;
+    renderContext.view = d->camera.viewMatrix();
+    renderContext.projection =
+        d->camera.projectionMatrix(static_cast<double>(widthPx) / std::max(heightPx, 1));
+    renderContext.widthPx = widthPx;
+    renderContext.heightPx = heightPx;
+    renderContext.targetFramebuffer = framebuffer;
+    renderContext.settle = settle;
+    renderContext.stats = &stats;
+    d->scene.render(renderContext);
+    if (settle) {
+        // A second pass draws what the first uploaded (the front converged in the first).
+        gl.glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+        gl.glClearColor(kBackground[0], kBackground[1], kBackground[2], 1.0f);
+        gl.glDepthMask(GL_TRUE);
+        gl.glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        stats = FrameStats{};
+        d->scene.render(renderContext);
+    }
+    stats.frameMs = static_cast<double>(timer.nsecsElapsed()) * 1e-6;
+    return stats;
+}
+
+void CloudView::paintGL() {
+    const qreal ratio = devicePixelRatioF();
+    const int widthPx = std::max(1, static_cast<int>(std::lround(width() * ratio)));
+    const int heightPx = std::max(1, static_cast<int>(std::lround(height() * ratio)));
+    FrameStats stats = renderFrame(defaultFramebufferObject(), widthPx, heightPx, false);
+
+    ++d->framesThisSecond;
+    const qint64 elapsedMs = d->fpsClock.elapsed();
+    if (elapsedMs >= 1000) {
+        d->fps = d->framesThisSecond * 1000.0 / static_cast<double>(elapsedMs);
+        d->framesThisSecond = 0;
+        d->fpsClock.restart();
+    }
+    stats.fps = d->fps;
+    d->lastStats = stats;
+    emit frameRendered(stats);
+    if (d->needsMoreFrames()) {
+        if (!d->frameTimer.isActive()) {
+            d->frameTimer.start();
+        }
+    } else if (d->flyKeys.isEmpty()) {
+        d->frameTimer.stop();
+    }
+}
+
+QImage CloudView::renderImage(const QSize& size) {
+    if (context() == nullptr || !isValid()) {
+        // Never shown: create the native window and the context without mapping it.
+        setAttribute(Qt::WA_DontShowOnScreen);
+        resize(size);
+        show();
+    }
+    if (!isValid()) {
+        return {};
+    }
+    makeCurrent();
+    QOpenGLFramebufferObject target(size, QOpenGLFramebufferObject::Depth);
+    const FrameStats stats = renderFrame(target.handle(), size.width(), size.height(), true);
+    QImage image = target.toImage(); // flipped: GL rows go bottom-up
+    d->lastStats = stats;
+    doneCurrent();
+    return image;
+}
+
+std::optional<QVector3D> CloudView::pickPoint(const QPoint& position) {
+    if (!d->glReady) {
+        return std::nullopt;
+    }
+    const qreal ratio = devicePixelRatioF();
+    const int widthPx = std::max(1, static_cast<int>(std::lround(width() * ratio)));
+    const int heightPx = std::max(1, static_cast<int>(std::lround(height() * ratio)));
+    const int x = static_cast<int>(position.x() * ratio);
+    const int y = heightPx - 1 - static_cast<int>(position.y() * ratio);
+    makeCurrent();
+    QOpenGLExtraFunctions& gl = *context()->extraFunctions();
+    gl.glBindFramebuffer(GL_FRAMEBUFFER, defaultFramebufferObject());
+    // The nearest depth in a small window: points are sparse, a single pixel often misses.
+    constexpr int kRadius = 4;
+    const int x0 = std::clamp(x - kRadius, 0, widthPx - 1);
+    const int y0 = std::clamp(y - kRadius, 0, heightPx - 1);
+    const int w = std::min(2 * kRadius + 1, widthPx - x0);
+    const int h = std::min(2 * kRadius + 1, heightPx - y0);
+    std::vector<float> depths(static_cast<std::size_t>(w * h), 1.0f);
+    gl.glReadPixels(x0, y0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depths.data());
+    doneCurrent();
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < depths.size(); ++i) {
+        if (depths[i] < depths[best]) {
+            best = i;
+        }
+    }
+    if (depths.empty() || depths[best] >= 1.0f) {
+        return std::nullopt;
+    }
+    const double px = x0 + static_cast<double>(best % static_cast<std::size_t>(w)) + 0.5;
+    const double py = y0 + static_cast<double>(best / static_cast<std::size_t>(w)) + 0.5;
+    const glm::dvec4 ndc(px / widthPx * 2.0 - 1.0, py / heightPx * 2.0 - 1.0,
+                         depths[best] * 2.0 - 1.0, 1.0);
+    const glm::dmat4 inverse = glm::inverse(
+        d->camera.projectionMatrix(static_cast<double>(widthPx) / heightPx) * d->camera.viewMatrix());
+    const glm::dvec4 world = inverse * ndc;
+    return QVector3D(static_cast<float>(world.x / world.w), static_cast<float>(world.y / world.w),
+                     static_cast<float>(world.z / world.w));
+}
+
+void CloudView::mousePressEvent(QMouseEvent* event) {
+    d->lastMouse = event->position().toPoint();
+    d->dragButtons = event->buttons();
+}
+
+void CloudView::mouseReleaseEvent(QMouseEvent* event) { d->dragButtons = event->buttons(); }
+
+void CloudView::mouseMoveEvent(QMouseEvent* event) {
+    const QPoint position = event->position().toPoint();
+    const QPoint delta = position - d->lastMouse;
+    d->lastMouse = position;
+    const bool panning = (event->buttons() & (Qt::RightButton | Qt::MiddleButton)) ||
+                         ((event->buttons() & Qt::LeftButton) && (event->modifiers() & Qt::ShiftModifier));
+    if (panning) {
+        d->camera.pan(delta.x(), delta.y(), height());
+    } else if (event->buttons() & Qt::LeftButton) {
+        if (d->flyMode) {
+            d->camera.look(delta.x(), delta.y());
+        } else {
+            d->camera.orbit(delta.x(), delta.y());
+        }
+    } else {
+        return;
+    }
+    d->autoFit = false;
+    update();
+}
+
+void CloudView::mouseDoubleClickEvent(QMouseEvent* event) {
+    if (const auto picked = pickPoint(event->position().toPoint())) {
+        d->camera.setPivot(glm::dvec3(picked->x(), picked->y(), picked->z()));
+        d->autoFit = false;
+        update();
+    }
+}
+
+void CloudView::wheelEvent(QWheelEvent* event) {
+    const double notches = event->angleDelta().y() / 120.0;
+    if (notches == 0.0) {
+        return;
+    }
+    const double factor = std::pow(kWheelZoomPerNotch, notches);
+    // Zoom to the point under the cursor; over empty space, towards the pivot.
+    const auto picked = pickPoint(event->position().toPoint());
+    const glm::dvec3 target = picked ? glm::dvec3(picked->x(), picked->y(), picked->z())
+                                     : d->camera.pivot();
+    d->camera.zoomToward(target, factor);
+    d->autoFit = false;
+    update();
+}
+
+void CloudView::keyPressEvent(QKeyEvent* event) {
+    switch (event->key()) {
+    case Qt::Key_W:
+    case Qt::Key_A:
+    case Qt::Key_S:
+    case Qt::Key_D:
+    case Qt::Key_Q:
+    case Qt::Key_E:
+        if (!event->isAutoRepeat()) {
+            if (d->flyKeys.isEmpty()) {
+                d->flyClock.restart();
+            }
+            d->flyKeys.insert(event->key());
+            d->autoFit = false;
+            d->frameTimer.start();
+        }
+        return;
+    case Qt::Key_F:
+        fitToCloud();
+        return;
+    default:
+        QOpenGLWidget::keyPressEvent(event);
+    }
+}
+
+void CloudView::keyReleaseEvent(QKeyEvent* event) {
+    if (!event->isAutoRepeat() && d->flyKeys.remove(event->key())) {
+        return;
+    }
+    QOpenGLWidget::keyReleaseEvent(event);
+}
+
+} // namespace omicron

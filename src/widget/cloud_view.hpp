@@ -1,0 +1,92 @@
+// omicron::CloudView: the embeddable QOpenGLWidget that draws a hierarchy while it is built.
+//
+// Give it a hierarchy (a HierarchyBuilder's, or one being loaded from a .omh file) and it
+// tracks the renderable part with a Front on the GUI thread, uploads node buffers within a
+// per-frame budget and draws them as points or surface splats. Builder threads never call GL.
+// Until the first sorted batch exists, a preview sample (the sorter's) can be shown instead.
+#pragma once
+
+#include "render_settings.hpp"
+#include "view_camera.hpp"
+
+#include <QOpenGLWidget>
+#include <QVector3D>
+#include <memory>
+#include <optional>
+
+namespace omicron {
+
+class Hierarchy;
+struct PreviewSample;
+struct CubeTransform;
+class CloudViewPrivate;
+
+class CloudView : public QOpenGLWidget {
+    Q_OBJECT
+public:
+    explicit CloudView(QWidget* parent = nullptr);
+    ~CloudView() override;
+
+    // Shows `hierarchy` (nullptr: nothing). May be called at any time, also while the
+    // hierarchy grows; the camera is fitted to it the first time a hierarchy is attached
+    // (and on fitToCloud()).
+    void setHierarchy(std::shared_ptr<const Hierarchy> hierarchy);
+    std::shared_ptr<const Hierarchy> hierarchy() const;
+    // Drawn while the attached hierarchy has nothing renderable yet (or none is attached).
+    void setPreview(const PreviewSample& preview, const CubeTransform& cube);
+    void clearPreview();
+
+    RenderSettings renderSettings() const;
+    void setRenderSettings(const RenderSettings& settings);
+
+    // Camera. Until the user navigates (or setCamera() is called), the view keeps framing the
+    // cloud as its bounds grow during a build.
+    ViewCamera camera() const;
+    void setCamera(const ViewCamera& camera);
+    void fitToCloud();
+    void setStandardView(StandardView view);
+    void setFlyMode(bool on);
+    bool flyMode() const;
+
+    // Statistics of the last frame drawn.
+    FrameStats lastFrameStats() const;
+
+    // Renders the current state at `size` into an image, with the front converged and every
+    // node it draws uploaded (no visible window needed: a never-shown view creates its
+    // context off screen). Empty image when no OpenGL 3.3 context could be made.
+    QImage renderImage(const QSize& size);
+
+    // The point under `position` (widget coordinates) in the hierarchy's unit cube, from the
+    // depth of the last frame; nothing over empty space.
+    std::optional<QVector3D> pickPoint(const QPoint& position);
+
+    // GL_RENDERER of the context (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"); empty before it exists.
+    QString glRendererName() const;
+
+    // Why nothing is drawn (no OpenGL 3.3, a shader failed); empty when all is well.
+    QString glErrorString() const;
+
+signals:
+    void frameRendered(const omicron::FrameStats& stats);
+    void renderSettingsChanged(const omicron::RenderSettings& settings);
+    void flyModeChanged(bool on);
+
+protected:
+    void initializeGL() override;
+    void resizeGL(int width, int height) override;
+    void paintGL() override;
+    void mousePressEvent(QMouseEvent* event) override;
+    void mouseReleaseEvent(QMouseEvent* event) override;
+    void mouseMoveEvent(QMouseEvent* event) override;
+    void mouseDoubleClickEvent(QMouseEvent* event) override;
+    void wheelEvent(QWheelEvent* event) override;
+    void keyPressEvent(QKeyEvent* event) override;
+    void keyReleaseEvent(QKeyEvent* event) override;
+
+private:
+    FrameStats renderFrame(unsigned framebuffer, int widthPx, int heightPx, bool settle);
+
+    std::unique_ptr<CloudViewPrivate> d;
+};
+
+} // namespace omicron

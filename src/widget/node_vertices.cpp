@@ -1,0 +1,62 @@
+#include "node_vertices.hpp"
+
+#include "hierarchy.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace omicron {
+
+namespace {
+
+std::uint32_t packSnorm10(float value) {
+    const auto quantized =
+        static_cast<std::int32_t>(std::lround(std::clamp(value, -1.0f, 1.0f) * 511.0f));
+    return static_cast<std::uint32_t>(quantized) & 0x3ffu;
+}
+
+// Intensity ranges differ between sensors (0-255 or 0-65535): a logarithmic byte keeps both
+// readable without knowing the cloud's maximum before the last point arrived.
+std::uint8_t packIntensity(std::uint16_t intensity) {
+    return static_cast<std::uint8_t>(std::lround(255.0 * std::log2(1.0 + intensity) / 16.0));
+}
+
+} // namespace
+
+std::uint32_t packNormal2101010(float x, float y, float z) {
+    return packSnorm10(x) | (packSnorm10(y) << 10) | (packSnorm10(z) << 20);
+}
+
+void packNodeVertices(const Hierarchy& hierarchy, const OctreeNode& node,
+                      std::vector<PointVertex>& out) {
+    const SortedCloud& cloud = hierarchy.cloud();
+    const SplatAttributes& splats = hierarchy.splats();
+    const auto positions = cloud.positions();
+    const auto colors = cloud.colors();
+    const auto intensities = cloud.intensities();
+    const bool hasColor = !colors.empty();
+    const bool hasIntensity = !intensities.empty();
+
+    out.resize(node.pointCount);
+    for (std::uint32_t i = 0; i < node.pointCount; ++i) {
+        const std::uint32_t point = node.heldPoint(i);
+        PointVertex& vertex = out[i];
+        const glm::vec3& p = positions[point];
+        vertex.x = p.x;
+        vertex.y = p.y;
+        vertex.z = p.z;
+        if (hasColor) {
+            vertex.r = colors[point].r;
+            vertex.g = colors[point].g;
+            vertex.b = colors[point].b;
+        } else {
+            vertex.r = vertex.g = vertex.b = 255;
+        }
+        vertex.intensity = hasIntensity ? packIntensity(intensities[point]) : 0;
+        const glm::vec3 normal = splats.normal(point);
+        vertex.normal = packNormal2101010(normal.x, normal.y, normal.z);
+        vertex.radius = splats.radius(point) * node.splatScale;
+    }
+}
+
+} // namespace omicron

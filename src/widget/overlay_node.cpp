@@ -1,0 +1,114 @@
+#include "overlay_node.hpp"
+
+#include "cloud_node.hpp"
+#include "shader_library.hpp"
+
+#include <glm/gtc/type_ptr.hpp>
+
+namespace omicron {
+
+namespace {
+
+// Enough cells to show the structure; beyond this the overlay only costs frame time.
+constexpr std::size_t kMaxCellsDrawn = 20000;
+
+constexpr std::uint8_t kBoxColor[4] = {200, 200, 200, 255};
+constexpr std::uint8_t kCutColor[4] = {255, 140, 0, 255};
+
+} // namespace
+
+void cellBounds(std::uint64_t code, glm::dvec3& min, glm::dvec3& max) {
+    const morton::Cell cell = morton::decode(code);
+    const double size = 1.0 / static_cast<double>(std::uint64_t{1} << morton::level(code));
+    min = glm::dvec3(cell.x, cell.y, cell.z) * size;
+    max = min + glm::dvec3(size);
+}
+
+void OverlayNode::initializeGL(QOpenGLExtraFunctions& gl) {
+    m_program = buildShaderProgram({"lines.vert", "lines.frag"});
+    gl.glGenVertexArrays(1, &m_vao);
+    gl.glGenBuffers(1, &m_vbo);
+}
+
+void OverlayNode::releaseGL(QOpenGLExtraFunctions& gl) {
+    if (m_vao != 0) {
+        gl.glDeleteVertexArrays(1, &m_vao);
+        gl.glDeleteBuffers(1, &m_vbo);
+    }
+    m_vao = m_vbo = 0;
+    m_program.reset();
+}
+
+void OverlayNode::addBox(const glm::dvec3& min, const glm::dvec3& max,
+                         const std::uint8_t (&rgba)[4]) {
+    const auto corner = [&](int i) {
+        return glm::vec3(i & 1 ? max.x : min.x, i & 2 ? max.y : min.y, i & 4 ? max.z : min.z);
+    };
+    static constexpr int kEdges[12][2] = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3},
+                                          {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+    for (const auto& edge : kEdges) {
+        for (int end : edge) {
+            const glm::vec3 p = corner(end);
+            m_lines.push_back({p.x, p.y, p.z, rgba[0], rgba[1], rgba[2], rgba[3]});
+        }
+    }
+}
+
+void OverlayNode::render(RenderContext& context) {
+    const RenderSettings& settings = *context.settings;
+    m_lines.clear();
+    if (settings.showBoundingBox && m_cloud.hasBounds()) {
+        addBox(m_cloud.boundsMin(), m_cloud.boundsMax(), kBoxColor);
+    }
+    if (const Front* front = m_cloud.front(); front != nullptr) {
+        std::size_t cells = 0;
+        for (const FrontEntry& entry : front->entries()) {
+            if (cells >= kMaxCellsDrawn) {
+                break;
+            }
+            glm::dvec3 min, max;
+            if (entry.placeholder && settings.showCutBoundary) {
+                cellBounds(entry.code, min, max);
+                addBox(min, max, kCutColor);
+                ++cells;
+            } else if (!entry.placeholder && entry.visible && settings.showOctreeCells) {
+                cellBounds(entry.code, min, max);
+                const float shade = 0.35f + 0.65f * static_cast<float>(entry.level()) / morton::kMaxLevel;
+                const auto channel = static_cast<std::uint8_t>(255.0f * shade);
+                const std::uint8_t rgba[4] = {60, channel, 255, 160};
+                addBox(min, max, rgba);
+                ++cells;
+            }
+        }
+    }
+    if (m_lines.empty()) {
+        return;
+    }
+    QOpenGLExtraFunctions& gl = *context.gl;
+    gl.glBindFramebuffer(GL_FRAMEBUFFER, context.targetFramebuffer);
+    gl.glBindVertexArray(m_vao);
+    gl.glBindBuffer(GL_ARRAY_BUFFER, m_vbo);
+    gl.glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(m_lines.size() * sizeof(LineVertex)),
+                    m_lines.data(), GL_STREAM_DRAW);
+    const auto stride = static_cast<GLsizei>(sizeof(LineVertex));
+    gl.glEnableVertexAttribArray(0);
+    gl.glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(0));
+    gl.glEnableVertexAttribArray(1);
+    gl.glVertexAttribPointer(1, 4, GL_UNSIGNED_BYTE, GL_TRUE, stride, reinterpret_cast<void*>(12));
+    gl.glEnable(GL_DEPTH_TEST);
+    gl.glDepthFunc(GL_LEQUAL);
+    gl.glEnable(GL_BLEND);
+    gl.glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    m_program->bind();
+    const glm::mat4 viewProjection(context.projection * context.view);
+    m_program->setUniformValue("u_viewProjection",
+                               QMatrix4x4(glm::value_ptr(viewProjection)).transposed());
+    gl.glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(m_lines.size()));
+    m_program->release();
+    gl.glDisable(GL_BLEND);
+    gl.glDepthFunc(GL_LESS);
+    gl.glBindBuffer(GL_ARRAY_BUFFER, 0);
+    gl.glBindVertexArray(0);
+}
+
+} // namespace omicron

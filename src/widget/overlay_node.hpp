@@ -1,0 +1,43 @@
+// Line overlays drawn after the cloud: the cloud's bounding box, the cells of the front's
+// nodes (coloured by level; optional) and the oblique cut's boundary — the leaves the builder
+// has inserted that are not settled yet, where the sweep is working now.
+#pragma once
+
+#include "scene_node.hpp"
+
+#include <QOpenGLShaderProgram>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace omicron {
+
+class CloudNode;
+
+class OverlayNode final : public SceneNode {
+public:
+    explicit OverlayNode(const CloudNode& cloud) : m_cloud(cloud) {}
+
+    void initializeGL(QOpenGLExtraFunctions& gl) override;
+    void render(RenderContext& context) override;
+    void releaseGL(QOpenGLExtraFunctions& gl) override;
+
+    struct LineVertex {
+        float x, y, z;
+        std::uint8_t r, g, b, a;
+    };
+
+private:
+    void addBox(const glm::dvec3& min, const glm::dvec3& max, const std::uint8_t (&rgba)[4]);
+
+    const CloudNode& m_cloud;
+    std::vector<LineVertex> m_lines;
+    std::unique_ptr<QOpenGLShaderProgram> m_program;
+    unsigned m_vao = 0;
+    unsigned m_vbo = 0;
+};
+
+// Cell of a Morton code in the unit cube.
+void cellBounds(std::uint64_t code, glm::dvec3& min, glm::dvec3& max);
+
+} // namespace omicron

@@ -1,0 +1,54 @@
+// Value types of the CloudView API: what to draw and how, and what a frame cost.
+#pragma once
+
+#include <QMetaType>
+#include <cstddef>
+
+namespace omicron {
+
+enum class RenderMode {
+    Points, // one GL point per point, screen size from the splat radius (fast)
+    Splats, // surface splats: visibility, Gaussian accumulation and normalisation passes
+};
+
+enum class ColorMode { Rgb, Normal, Height, Intensity, Level, BuildAge };
+
+enum class StandardView { Top, Bottom, Front, Back, Left, Right, Iso };
+
+struct RenderSettings {
+    RenderMode mode = RenderMode::Points;
+    ColorMode color = ColorMode::Rgb; // falls back to Height where the cloud has no colour
+    float pointSizeScale = 1.0f;      // multiplies the splat radius on screen
+    // Front: a node whose cell projects larger than this branches, smaller prunes. 16 px draws
+    // the lion (342k points) with 40k points at 500x500 and no visible loss of detail.
+    double projectionThresholdPx = 16.0;
+    // Most points drawn per frame: Mesa llvmpipe draws ~3M points/s, so 1M keeps it usable.
+    std::size_t pointBudget = 1'000'000;
+    double frontBudgetMs = 2.0;            // front evaluation CPU time per frame
+    std::size_t uploadBudgetBytes = 32u << 20;      // GPU uploads per frame
+    std::size_t gpuMemoryBudgetBytes = 1024u << 20; // node buffers kept on the GPU
+    bool showBoundingBox = true;   // the cloud's bounding box
+    bool showOctreeCells = false;  // wireframe of the front's node cells
+    bool showCutBoundary = true;   // highlight of the roots of the oblique cut
+    bool showAxes = true;          // axis gizmo in the corner
+    friend bool operator==(const RenderSettings&, const RenderSettings&) = default;
+};
+
+struct FrameStats {
+    double frameMs = 0.0;  // CPU time of paintGL (front, uploads, draw calls)
+    double frontMs = 0.0;  // front evaluation alone
+    double fps = 0.0;      // frames per second over the last second
+    std::size_t frontNodes = 0;
+    std::size_t placeholders = 0;
+    std::size_t nodesDrawn = 0;
+    std::size_t pointsDrawn = 0;
+    std::size_t pointsTotal = 0;   // points of the cloud (input)
+    std::size_t uploads = 0;       // node buffers uploaded this frame
+    std::size_t gpuBytes = 0;      // node buffers resident on the GPU
+    bool showingPreview = false;
+};
+
+} // namespace omicron
+
+Q_DECLARE_METATYPE(omicron::RenderSettings)
+Q_DECLARE_METATYPE(omicron::FrameStats)

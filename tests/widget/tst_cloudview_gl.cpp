@@ -1,0 +1,165 @@
+// CloudView under a real GL context (Xvfb + Mesa llvmpipe in CI): what it draws, checked by
+// pixel statistics of renderImage() from fixed cameras.
+#include "cloud_view.hpp"
+#include "hierarchy_builder.hpp"
+#include "morton_sorter.hpp"
+#include "point_reader.hpp"
+#include "widget_test_support.hpp"
+
+#include <QSignalSpy>
+#include <QtTest>
+#include <cmath>
+
+using namespace omicron;
+
+namespace {
+
+RenderSettings plainSettings() {
+    RenderSettings settings;
+    settings.showAxes = false;
+    settings.showBoundingBox = false;
+    settings.showCutBoundary = false;
+    return settings;
+}
+
+PreviewSample spherePreview(std::size_t count) {
+    PreviewSample preview;
+    for (std::size_t i = 0; i < count; ++i) {
+        // A Fibonacci sphere: evenly spread points of radius 0.4 around the cube's centre.
+        const double z = 1.0 - 2.0 * (static_cast<double>(i) + 0.5) / static_cast<double>(count);
+        const double ring = std::sqrt(1.0 - z * z);
+        const double angle = static_cast<double>(i) * 2.399963229728653;
+        preview.positions.emplace_back(0.5 + 0.4 * ring * std::cos(angle),
+                                       0.5 + 0.4 * ring * std::sin(angle), 0.5 + 0.4 * z);
+        preview.colors.emplace_back(220, 40, 40);
+    }
+    preview.pointsSeen = count;
+    return preview;
+}
+
+} // namespace
+
+class tst_CloudViewGL : public QObject {
+    Q_OBJECT
+private slots:
+    void emptyViewDrawsOnlyTheBackground() {
+        CloudView view;
+        view.setRenderSettings(plainSettings());
+        const QImage image = view.renderImage(QSize(200, 150));
+        QVERIFY2(!image.isNull(), qPrintable(view.glErrorString()));
+        QCOMPARE(image.size(), QSize(200, 150));
+        QCOMPARE(test::coverage(image, test::viewBackground()), 0.0);
+    }
+
+    void previewIsDrawnBeforeAnyHierarchy() {
+        CloudView view;
+        view.setRenderSettings(plainSettings());
+        view.setPreview(spherePreview(20000), CubeTransform{});
+        const QImage image = view.renderImage(QSize(320, 240));
+        QVERIFY2(!image.isNull(), qPrintable(view.glErrorString()));
+        const double covered = test::coverage(image, test::viewBackground());
+        // Fitting frames the box's bounding sphere: this sphere's disc spans about half the
+        // frame height, pi * (0.25 * 240)^2 / (320 * 240) = 0.147 of the pixels.
+        QVERIFY2(covered > 0.12 && covered < 0.2, qPrintable(QString::number(covered)));
+        QVERIFY(view.lastFrameStats().showingPreview);
+        QCOMPARE(view.lastFrameStats().pointsDrawn, std::size_t{20000});
+        // The centre is red, the corner is background.
+        const QColor centre = image.pixelColor(160, 120);
+        QVERIFY2(centre.red() > 150 && centre.green() < 100, qPrintable(centre.name()));
+        QCOMPARE(image.pixelColor(2, 2).rgb(), test::viewBackground().rgb());
+    }
+
+    void bunnyRendersWithItsSilhouette() {
+        const QString path = test::sharedDataFile("bunny.ply");
+        if (path.isEmpty()) {
+            QSKIP("../shared/data/bunny.ply is absent");
+        }
+        CloudView view;
+        view.setRenderSettings(plainSettings());
+        view.setHierarchy(test::buildHierarchy(path, BuildOptions{}));
+        view.setStandardView(StandardView::Front);
+        const QImage image = view.renderImage(QSize(400, 400));
+        QVERIFY2(!image.isNull(), qPrintable(view.glErrorString()));
+        const double covered = test::coverage(image, test::viewBackground());
+        image.save("/tmp/bunny_front.png");
+        QVERIFY2(covered > 0.10 && covered < 0.3, qPrintable(QString::number(covered)));
+        QVERIFY(!view.lastFrameStats().showingPreview);
+        QVERIFY(view.lastFrameStats().pointsDrawn > 0);
+    }
+
+    void lionRendersInColourAndAsSplats() {
+        const QString path = test::sharedDataFile("lion.ply");
+        if (path.isEmpty()) {
+            QSKIP("../shared/data/lion.ply is absent");
+        }
+        CloudView view;
+        RenderSettings settings = plainSettings();
+        view.setRenderSettings(settings);
+        view.setHierarchy(test::buildHierarchy(path, BuildOptions{}));
+        view.setStandardView(StandardView::Front);
+        const QImage points = view.renderImage(QSize(400, 400));
+        points.save("/tmp/lion_points.png");
+        settings.mode = RenderMode::Splats;
+        view.setRenderSettings(settings);
+        const QImage splats = view.renderImage(QSize(400, 400));
+        splats.save("/tmp/lion_splats.png");
+        const double pointCoverage = test::coverage(points, test::viewBackground());
+        const double splatCoverage = test::coverage(splats, test::viewBackground());
+        QVERIFY2(pointCoverage > 0.05, qPrintable(QString::number(pointCoverage)));
+        QVERIFY2(std::abs(splatCoverage - pointCoverage) < 0.25 * pointCoverage,
+                 qPrintable(QString("%1 vs %2").arg(splatCoverage).arg(pointCoverage)));
+    }
+
+    // The renderer reads the hierarchy while the builder grows it (another thread): every
+    // frame shows a consistent part of the cloud, and the part grows as input arrives.
+    void coverageGrowsWhileABuildRuns() {
+        const QString path = test::sharedDataFile("lion.ply");
+        if (path.isEmpty()) {
+            QSKIP("../shared/data/lion.ply is absent");
+        }
+        auto reader = openPointCloud(path.toStdString());
+        SortOptions sortOptions;
+        sortOptions.batchPoints = 20000;
+        IncrementalMortonSorter sorter(reader->info(), sortOptions);
+        reader->read([&](const PointBatch& batch) { sorter.add(batch); });
+        std::vector<std::pair<std::size_t, std::size_t>> ranges;
+        sorter.sortAndEmit([&](const SortedCloud&, std::size_t begin, std::size_t end) {
+            ranges.emplace_back(begin, end);
+        });
+        QVERIFY(ranges.size() >= 10);
+
+        HierarchyBuilder builder(sorter.cloud(), BuildOptions{});
+        CloudView view;
+        view.setRenderSettings(plainSettings());
+        view.setHierarchy(builder.sharedHierarchy());
+        ViewCamera camera; // a fixed camera on the whole cube, so coverage can only grow
+        camera.setSceneBox(glm::dvec3(0.0), glm::dvec3(1.0));
+        camera.setStandardView(StandardView::Front);
+        view.setCamera(camera);
+
+        std::vector<double> coverages;
+        const std::size_t step = (ranges.size() + 5) / 6;
+        for (std::size_t i = 0; i < ranges.size(); ++i) {
+            builder.onSortedRange(*sorter.cloud(), ranges[i].first, ranges[i].second);
+            if (i % step == step - 1) {
+                coverages.push_back(test::coverage(view.renderImage(QSize(200, 200)), test::viewBackground()));
+            }
+        }
+        builder.finish();
+        builder.wait();
+        coverages.push_back(test::coverage(view.renderImage(QSize(200, 200)), test::viewBackground()));
+        QString trace;
+        for (double c : coverages) {
+            trace += QString::number(c, 'f', 4) + " ";
+        }
+        QVERIFY2(coverages.back() > 0.05, qPrintable(trace));
+        QVERIFY2(coverages.back() > coverages.front(), qPrintable(trace));
+        for (std::size_t i = 1; i < coverages.size(); ++i) {
+            // Monotonic up to the few pixels a parent's splats differ from its children's.
+            QVERIFY2(coverages[i] >= coverages[i - 1] - 0.005, qPrintable(trace));
+        }
+    }
+};
+
+QTEST_MAIN(tst_CloudViewGL)
+#include "tst_cloudview_gl.moc"

@@ -1,0 +1,47 @@
+#include "widget_test_support.hpp"
+
+#include "hierarchy_builder.hpp"
+#include "morton_sorter.hpp"
+#include "point_reader.hpp"
+
+#include <QFileInfo>
+#include <cstdlib>
+
+namespace omicron::test {
+
+QString sharedDataFile(const char* name) {
+    const QString path = QStringLiteral(OMICRON_SHARED_DATA_DIR "/") + QString::fromUtf8(name);
+    return QFileInfo::exists(path) ? path : QString();
+}
+
+std::shared_ptr<const Hierarchy> buildHierarchy(const QString& path, const BuildOptions& options) {
+    auto reader = openPointCloud(path.toStdString());
+    IncrementalMortonSorter sorter(reader->info(), SortOptions{});
+    HierarchyBuilder builder(sorter.cloud(), options);
+    reader->read([&](const PointBatch& batch) { sorter.add(batch); });
+    sorter.sortAndEmit(builder.consumer());
+    builder.finish();
+    builder.wait();
+    return builder.sharedHierarchy();
+}
+
+double coverage(const QImage& image, const QColor& background) {
+    const QImage rgb = image.convertToFormat(QImage::Format_RGB32);
+    const QRgb clear = background.rgb();
+    std::size_t covered = 0;
+    for (int y = 0; y < rgb.height(); ++y) {
+        const auto* line = reinterpret_cast<const QRgb*>(rgb.constScanLine(y));
+        for (int x = 0; x < rgb.width(); ++x) {
+            const QRgb pixel = line[x];
+            const int difference = std::abs(qRed(pixel) - qRed(clear)) +
+                                   std::abs(qGreen(pixel) - qGreen(clear)) +
+                                   std::abs(qBlue(pixel) - qBlue(clear));
+            covered += difference > 24 ? 1 : 0;
+        }
+    }
+    return static_cast<double>(covered) / std::max(1, rgb.width() * rgb.height());
+}
+
+QColor viewBackground() { return QColor::fromRgbF(0.11f, 0.12f, 0.14f); }
+
+} // namespace omicron::test
