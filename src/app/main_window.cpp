@@ -25,9 +25,7 @@
 #include <QSettings>
 #include <QUrl>
 
-#ifdef OMICRON_HAVE_CLOUD_VIEW
 #include "cloud_view.hpp"
-#endif
 
 namespace omicron {
 
@@ -84,17 +82,10 @@ MainWindow::~MainWindow() {
 
 // The one place the central widget is made: CloudView where the widget library is built.
 QWidget* MainWindow::createCentralView() {
-#ifdef OMICRON_HAVE_CLOUD_VIEW
     m_view = new CloudView(this);
     m_view->setObjectName(QStringLiteral("cloudView"));
     m_view->setMinimumSize(320, 240);
     return m_view;
-#else
-    auto* label = new QLabel(tr("This build of omicron has no renderer (omicron_widget)."), this);
-    label->setAlignment(Qt::AlignCenter);
-    label->setObjectName(QStringLiteral("cloudView"));
-    return label;
-#endif
 }
 
 void MainWindow::createDocks() {
@@ -189,7 +180,6 @@ void MainWindow::connectActions() {
     m_ui->actionShowCutBoundary->setChecked(true);
     m_ui->actionShowAxes->setChecked(true);
 
-#ifdef OMICRON_HAVE_CLOUD_VIEW
     const auto editSettings = [this](auto&& edit) {
         RenderSettings settings = m_view->renderSettings();
         edit(settings);
@@ -257,18 +247,6 @@ void MainWindow::connectActions() {
         m_pointsDrawn = stats.pointsDrawn;
         m_fps = stats.fps;
     });
-#else
-    // Without a renderer the view actions have nothing to act on.
-    for (QMenu* menu : {m_ui->menuRenderMode, m_ui->menuColorMode, m_ui->menuStandardViews}) {
-        menu->setEnabled(false);
-    }
-    for (QAction* action :
-         {m_ui->actionPointSizeLarger, m_ui->actionPointSizeSmaller, m_ui->actionPointSizeReset,
-          m_ui->actionFit, m_ui->actionFlyMode, m_ui->actionShowOctreeCells,
-          m_ui->actionShowCutBoundary, m_ui->actionShowAxes, m_ui->actionSaveScreenshot}) {
-        action->setEnabled(false);
-    }
-#endif
 }
 
 void MainWindow::connectService() {
@@ -297,7 +275,6 @@ void MainWindow::connectService() {
                 m_cutPanel->setStatistics(statistics);
                 m_chartsPanel->setHierarchyBytes(statistics.bytesResident());
             });
-#ifdef OMICRON_HAVE_CLOUD_VIEW
     connect(m_service, &BuilderService::hierarchyChanged, this,
             [this](std::shared_ptr<const Hierarchy> hierarchy) {
                 m_view->setHierarchy(std::move(hierarchy));
@@ -306,7 +283,6 @@ void MainWindow::connectService() {
             [this](const PreviewSample& preview, const CubeTransform& cube) {
                 m_view->setPreview(preview, cube);
             });
-#endif
     connect(m_service, &BuilderService::buildFinished, this, [this](const PipelineResult& result) {
         const QLocale locale;
         statusBar()->showMessage(
@@ -356,12 +332,8 @@ void MainWindow::exportPoints(const QString& path) {
 }
 
 bool MainWindow::saveScreenshot(const QString& path) {
-#ifdef OMICRON_HAVE_CLOUD_VIEW
     const QImage image = m_view->renderImage(m_view->size() * m_view->devicePixelRatio());
     return !image.isNull() && image.save(path);
-#else
-    return grab().save(path);
-#endif
 }
 
 QMessageBox* MainWindow::errorDialog() const {
@@ -488,13 +460,11 @@ void MainWindow::updateStatus() {
 void MainWindow::applyViewParameters(const ViewParameters& parameters) {
     m_ui->actionPoints->setChecked(!parameters.splats);
     m_ui->actionSplats->setChecked(parameters.splats);
-#ifdef OMICRON_HAVE_CLOUD_VIEW
     RenderSettings settings = m_view->renderSettings();
     settings.projectionThresholdPx = parameters.projectionThresholdPx;
     settings.pointBudget = parameters.pointBudget;
     settings.mode = parameters.splats ? RenderMode::Splats : RenderMode::Points;
     m_view->setRenderSettings(settings);
-#endif
 }
 
 QString MainWindow::askSavePath(const QString& title, const QString& filter,

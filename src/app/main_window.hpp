@@ -41,7 +41,7 @@ public:
     BuildPanel* buildPanel() const { return m_buildPanel; }
     CutPanel* cutPanel() const { return m_cutPanel; }
     ChartsPanel* chartsPanel() const { return m_chartsPanel; }
-    // The central CloudView; nullptr in a build without the widget library.
+    // The central CloudView.
     CloudView* cloudView() const { return m_view; }
     QStringList recentFiles() const { return m_recentFiles; }
     // The error dialog currently shown (nullptr when none).
