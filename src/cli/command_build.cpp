@@ -2,11 +2,9 @@
 // builder), then the build statistics as text or JSON.
 #include "cli_args.hpp"
 #include "commands.hpp"
-#include "hierarchy_builder.hpp"
+#include "build_pipeline.hpp"
 #include "json_writer.hpp"
-#include "oms_reader.hpp"
 #include "omh_writer.hpp"
-#include "point_reader.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -18,51 +16,6 @@
 namespace omicron::cli {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-struct BuildRun {
-    BuildStatistics stats;
-    double readSeconds = 0.0;
-    double sortSeconds = 0.0; // 0 for a .oms input: it is sorted already
-    std::string pipeline;
-    std::string savedPath; // empty without --save
-    std::uint64_t savedBytes = 0;
-};
-
-// Test hook, not a user option: with OMICRON_TEST_PAUSE_SAVE_AFTER_LEVEL=N in the
-// environment, a save stops for a minute after level N's points went to the temporary file,
-// so a test can kill the process half-way and check that the previous file survives.
-OmhWriteOptions saveOptions() {
-    OmhWriteOptions options;
-    if (const char* pauseLevel = std::getenv("OMICRON_TEST_PAUSE_SAVE_AFTER_LEVEL")) {
-        const int level = std::atoi(pauseLevel);
-        options.afterLevel = [level](int written) {
-            if (written == level) {
-                std::fprintf(stderr, "omicron-cli: save paused after level %d (test hook)\n",
-                             level);
-                std::fflush(stderr);
-                std::this_thread::sleep_for(std::chrono::seconds(60));
-            }
-        };
-    }
-    return options;
-}
-
-// --save: the finished hierarchy as a .omh file (pipeline 3's input).
-void saveIfAsked(const HierarchyBuilder& builder, const std::string& savePath, BuildRun& run) {
-    if (savePath.empty()) {
-        return;
-    }
-    writeOmh(savePath, builder.hierarchy(), omhBuildInfo(builder.options(), run.stats),
-             saveOptions());
-    run.savedPath = savePath;
-    run.savedBytes = std::filesystem::file_size(savePath);
-}
 
 LeafCollapse parseCollapse(const std::string& text) {
     if (text == "off") {
@@ -86,45 +39,31 @@ double parseRatio(const std::string& text) {
     return ratio;
 }
 
-BuildRun buildFromSortedStream(const std::string& path, const BuildOptions& options,
-                               const std::string& savePath) {
-    BuildRun run;
-    run.pipeline = "sorted stream (.oms) -> builder";
-    OmsReader reader(path);
-    HierarchyBuilder builder(reader.cloud(), options);
-    const auto readStart = Clock::now();
-    reader.read(builder.consumer());
-    run.readSeconds = secondsSince(readStart);
-    builder.finish();
-    builder.wait();
-    run.stats = builder.statistics();
-    saveIfAsked(builder, savePath, run);
-    return run;
+struct SavedFile {
+    std::string path; // empty without --save
+    std::uint64_t bytes = 0;
+};
+
+// Test hook, not a user option: with OMICRON_TEST_PAUSE_SAVE_AFTER_LEVEL=N in the
+// environment, a save stops for a minute after level N's points went to the temporary file,
+// so a test can kill the process half-way and check that the previous file survives.
+OmhWriteOptions saveOptions() {
+    OmhWriteOptions options;
+    if (const char* pauseLevel = std::getenv("OMICRON_TEST_PAUSE_SAVE_AFTER_LEVEL")) {
+        const int level = std::atoi(pauseLevel);
+        options.afterLevel = [level](int written) {
+            if (written == level) {
+                std::fprintf(stderr, "omicron-cli: save paused after level %d (test hook)\n",
+                             level);
+                std::fflush(stderr);
+                std::this_thread::sleep_for(std::chrono::seconds(60));
+            }
+        };
+    }
+    return options;
 }
 
-BuildRun buildFromCloud(const std::string& path, const BuildOptions& options, int chunks,
-                        const std::string& savePath) {
-    BuildRun run;
-    run.pipeline = "unsorted cloud -> incremental sorter -> builder";
-    auto reader = openPointCloud(path);
-    SortOptions sortOptions;
-    sortOptions.chunks = chunks;
-    IncrementalMortonSorter sorter(reader->info(), sortOptions);
-    HierarchyBuilder builder(sorter.cloud(), options);
-    const auto readStart = Clock::now();
-    reader->read([&](const PointBatch& batch) { sorter.add(batch); });
-    run.readSeconds = secondsSince(readStart);
-    const auto sortStart = Clock::now();
-    sorter.sortAndEmit(builder.consumer());
-    run.sortSeconds = secondsSince(sortStart);
-    builder.finish();
-    builder.wait();
-    run.stats = builder.statistics();
-    saveIfAsked(builder, savePath, run);
-    return run;
-}
-
-void printJson(const BuildRun& run, const BuildOptions& options) {
+void printJson(const PipelineResult& run, const BuildOptions& options, const SavedFile& saved) {
     const BuildStatistics& s = run.stats;
     JsonWriter json;
     json.beginObject();
@@ -161,15 +100,15 @@ void printJson(const BuildRun& run, const BuildOptions& options) {
     json.key("fix_passes").value(s.fixPasses);
     json.key("duplicate_parents_merged").value(s.duplicateParentsMerged);
     json.key("complete").value(s.complete);
-    if (!run.savedPath.empty()) {
-        json.key("saved").value(run.savedPath);
-        json.key("saved_bytes").value(run.savedBytes);
+    if (!saved.path.empty()) {
+        json.key("saved").value(saved.path);
+        json.key("saved_bytes").value(saved.bytes);
     }
     json.endObject();
     std::printf("%s\n", json.text().c_str());
 }
 
-void printText(const BuildRun& run, const BuildOptions& options) {
+void printText(const PipelineResult& run, const BuildOptions& options, const SavedFile& saved) {
     const BuildStatistics& s = run.stats;
     std::printf("pipeline:    %s\n", run.pipeline.c_str());
     std::printf("parameters:  depth %d, ratio %.3g, worklist %zu, leaf collapse %s\n",
@@ -190,9 +129,9 @@ void printText(const BuildRun& run, const BuildOptions& options) {
     std::printf("memory:      %.1f MiB resident (%.1f bytes per input point)\n",
                 s.bytesResident() / 1048576.0,
                 s.inputPoints ? double(s.bytesResident()) / double(s.inputPoints) : 0.0);
-    if (!run.savedPath.empty()) {
-        std::printf("saved:       %s (%llu bytes)\n", run.savedPath.c_str(),
-                    static_cast<unsigned long long>(run.savedBytes));
+    if (!saved.path.empty()) {
+        std::printf("saved:       %s (%llu bytes)\n", saved.path.c_str(),
+                    static_cast<unsigned long long>(saved.bytes));
     }
 }
 
@@ -233,13 +172,17 @@ int runBuild(const std::vector<std::string>& args) {
                                     static_cast<std::size_t>(threads));
 
     const std::string& path = parsed.positionals[0];
-    const std::string savePath = parsed.value("save").value_or("");
-    const BuildRun run = isOmsFile(path) ? buildFromSortedStream(path, options, savePath)
-                                         : buildFromCloud(path, options, chunks, savePath);
+    BuildPipeline pipeline;
+    const PipelineResult run = pipeline.run(path, {options, chunks});
+    SavedFile saved;
+    if (const auto savePath = parsed.value("save")) { // the finished hierarchy, pipeline 3's input
+        writeOmh(*savePath, *pipeline.hierarchy(), omhBuildInfo(options, run.stats), saveOptions());
+        saved = {*savePath, std::filesystem::file_size(*savePath)};
+    }
     if (parsed.flag("json")) {
-        printJson(run, options);
+        printJson(run, options, saved);
     } else {
-        printText(run, options);
+        printText(run, options, saved);
     }
     return 0;
 }

@@ -15,6 +15,10 @@ struct LevelStatistics {
     std::uint64_t nodes = 0;
     std::uint64_t leaves = 0;
     std::uint64_t points = 0; // points held by the level's nodes (samples for parents)
+    // The oblique cut as the last fix pass left it (what the GUI's cut panel shows):
+    std::uint64_t cutRoots = 0;            // entries of L_level, placeholders included
+    std::uint64_t placeholdersPending = 0; // of those, placeholders still rising
+    std::uint64_t placeholdersSubstituted = 0; // leaves of this level a placeholder became
 };
 
 struct BuildStatistics {

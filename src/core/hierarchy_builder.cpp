@@ -464,6 +464,7 @@ void HierarchyBuilder::fixLevel(int level) {
         parentLevel.points += node.pointCount;
         if (draft.substituted) {
             ++parentLevel.leaves;
+            ++parentLevel.placeholdersSubstituted;
             ++m_stats.placeholdersSubstituted;
             m_stats.droppedPoints += node.coveredCount - node.pointCount;
         }
@@ -510,6 +511,15 @@ void HierarchyBuilder::checkInvariants(bool completePass) {
 }
 
 void HierarchyBuilder::publishStatistics() {
+    // Walks L_C once per pass: after a fix the lists hold only the boundary, a small part of
+    // the nodes, so this costs little next to the pass itself.
+    for (int level = 0; level <= m_options.maxLevel; ++level) {
+        LevelStatistics& levelStats = m_stats.levels[static_cast<std::size_t>(level)];
+        const std::span<const CutRoot> roots = m_cut.roots(level);
+        levelStats.cutRoots = roots.size();
+        levelStats.placeholdersPending = static_cast<std::uint64_t>(
+            std::count_if(roots.begin(), roots.end(), [](const CutRoot& r) { return r.placeholder; }));
+    }
     m_stats.nodeBytes = m_hierarchy->nodeBytes();
     m_stats.sampleBytes = m_hierarchy->sampleBytes();
     m_stats.splatBytes = m_hierarchy->splatBytes();

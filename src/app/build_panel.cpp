@@ -1,0 +1,107 @@
+#include "build_panel.hpp"
+
+#include "ui_buildpanel.h"
+
+#include <QSettings>
+
+namespace omicron {
+
+BuildPanel::BuildPanel(QWidget* parent)
+    : QWidget(parent), m_ui(std::make_unique<Ui::BuildPanel>()) {
+    m_ui->setupUi(this);
+    m_ui->depthSpin->setMaximum(morton::kMaxLevel);
+    m_ui->chunksSpin->setMaximum(kMaxSortChunks);
+    setPipelineOptions(PipelineOptions{});
+    setViewParameters(ViewParameters{});
+    connect(m_ui->rebuildButton, &QPushButton::clicked, this, &BuildPanel::requestRebuild);
+    connect(m_ui->cancelButton, &QPushButton::clicked, this, &BuildPanel::cancelRequested);
+    const auto viewEdited = [this] {
+        emit viewParametersChanged(viewParameters());
+    };
+    connect(m_ui->thresholdSpin, &QDoubleSpinBox::valueChanged, this, viewEdited);
+    connect(m_ui->budgetSpin, &QSpinBox::valueChanged, this, viewEdited);
+    connect(m_ui->splatCombo, &QComboBox::currentIndexChanged, this, viewEdited);
+}
+
+BuildPanel::~BuildPanel() = default;
+
+PipelineOptions BuildPanel::pipelineOptions() const {
+    PipelineOptions options;
+    options.build.maxLevel = m_ui->depthSpin->value();
+    options.build.collapse = static_cast<LeafCollapse>(m_ui->collapseCombo->currentIndex());
+    options.build.ratio = m_ui->ratioSpin->value();
+    options.build.worklistSize = static_cast<std::size_t>(m_ui->worklistSpin->value());
+    options.build.threads = m_ui->threadsSpin->value();
+    options.sortChunks = m_ui->chunksSpin->value();
+    return options;
+}
+
+void BuildPanel::setPipelineOptions(const PipelineOptions& options) {
+    m_ui->depthSpin->setValue(options.build.maxLevel);
+    m_ui->collapseCombo->setCurrentIndex(static_cast<int>(options.build.collapse));
+    m_ui->ratioSpin->setValue(options.build.ratio);
+    m_ui->worklistSpin->setValue(static_cast<int>(options.build.worklistSize));
+    m_ui->threadsSpin->setValue(options.build.threads);
+    m_ui->chunksSpin->setValue(options.sortChunks);
+}
+
+ViewParameters BuildPanel::viewParameters() const {
+    ViewParameters parameters;
+    parameters.projectionThresholdPx = m_ui->thresholdSpin->value();
+    parameters.pointBudget = static_cast<std::size_t>(m_ui->budgetSpin->value()) * 1000;
+    parameters.splats = m_ui->splatCombo->currentIndex() == 1;
+    return parameters;
+}
+
+void BuildPanel::setViewParameters(const ViewParameters& parameters) {
+    m_ui->thresholdSpin->setValue(parameters.projectionThresholdPx);
+    m_ui->budgetSpin->setValue(static_cast<int>(parameters.pointBudget / 1000));
+    m_ui->splatCombo->setCurrentIndex(parameters.splats ? 1 : 0);
+}
+
+void BuildPanel::loadSettings(const QSettings& settings) {
+    const PipelineOptions defaults;
+    PipelineOptions options;
+    // The spin boxes clamp what a hand-edited settings file may hold.
+    options.build.maxLevel = settings.value("build/depth", defaults.build.maxLevel).toInt();
+    options.build.collapse =
+        static_cast<LeafCollapse>(std::clamp(settings.value("build/collapse", 0).toInt(), 0, 2));
+    options.build.ratio = settings.value("build/ratio", defaults.build.ratio).toDouble();
+    options.build.worklistSize =
+        settings.value("build/worklist", qulonglong(defaults.build.worklistSize)).toULongLong();
+    options.build.threads = settings.value("build/threads", 0).toInt();
+    options.sortChunks = settings.value("build/sortChunks", defaults.sortChunks).toInt();
+    setPipelineOptions(options);
+    const ViewParameters viewDefaults;
+    ViewParameters view;
+    view.projectionThresholdPx =
+        settings.value("view/projectionThresholdPx", viewDefaults.projectionThresholdPx).toDouble();
+    view.pointBudget =
+        settings.value("view/pointBudget", qulonglong(viewDefaults.pointBudget)).toULongLong();
+    view.splats = settings.value("view/splats", false).toBool();
+    setViewParameters(view);
+}
+
+void BuildPanel::saveSettings(QSettings& settings) const {
+    const PipelineOptions options = pipelineOptions();
+    settings.setValue("build/depth", options.build.maxLevel);
+    settings.setValue("build/collapse", static_cast<int>(options.build.collapse));
+    settings.setValue("build/ratio", options.build.ratio);
+    settings.setValue("build/worklist", qulonglong(options.build.worklistSize));
+    settings.setValue("build/threads", options.build.threads);
+    settings.setValue("build/sortChunks", options.sortChunks);
+    const ViewParameters view = viewParameters();
+    settings.setValue("view/projectionThresholdPx", view.projectionThresholdPx);
+    settings.setValue("view/pointBudget", qulonglong(view.pointBudget));
+    settings.setValue("view/splats", view.splats);
+}
+
+void BuildPanel::setBusy(bool busy) {
+    m_ui->cancelButton->setEnabled(busy);
+}
+
+void BuildPanel::requestRebuild() {
+    emit rebuildRequested(pipelineOptions().build);
+}
+
+} // namespace omicron

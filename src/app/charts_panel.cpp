@@ -1,0 +1,117 @@
+#include "charts_panel.hpp"
+
+#include "process_memory.hpp"
+#include "time_series_chart.hpp"
+
+#include <QGridLayout>
+
+namespace omicron {
+
+ChartsPanel::ChartsPanel(QWidget* parent) : QWidget(parent) {
+    auto* grid = new QGridLayout(this);
+    grid->setContentsMargins(2, 2, 2, 2);
+    grid->setSpacing(2);
+    const auto add = [&](const QString& title, const QString& unit, const QStringList& lines) {
+        auto* chart = new TimeSeriesChart(title, unit, lines, this);
+        connect(chart, &TimeSeriesChart::exportFailed, this, &ChartsPanel::exportFailed);
+        const int index = static_cast<int>(m_charts.size());
+        grid->addWidget(chart, index / 3, index % 3);
+        m_charts.push_back(chart);
+        return chart;
+    };
+    m_inserted = add(tr("Inserted points"), tr("points"),
+                     {tr("inserted"), tr("sorted"), tr("ideal (constant rate)")});
+    m_delay = add(tr("Insertion delay"), tr("s"), {tr("sorted -> inserted")});
+    m_front = add(tr("Front size"), tr("nodes"), {tr("front nodes")});
+    m_cpu = add(tr("CPU per frame"), tr("ms"), {tr("total"), tr("front evaluation")});
+    m_fpsChart = add(tr("Frame rate"), tr("fps"), {tr("fps")});
+    m_memory = add(tr("Memory"), tr("MiB"), {tr("process resident"), tr("hierarchy + cloud")});
+    m_inserted->setToolTip(m_inserted->toolTip() +
+                           tr("\nThe ideal line is the straight line to the final point count: "
+                              "insertion at a constant rate."));
+    m_delay->setToolTip(m_delay->toolTip() +
+                        tr("\nHow long ago the points now inserted into the hierarchy had been "
+                           "sorted: the wait between the sorter and the builder."));
+    m_timer.setInterval(kSampleIntervalMs);
+    connect(&m_timer, &QTimer::timeout, this, &ChartsPanel::sample);
+    m_clock.start();
+    m_timer.start();
+}
+
+TimeSeriesChart* ChartsPanel::chart(const QString& title) const {
+    for (TimeSeriesChart* chart : m_charts) {
+        if (chart->title() == title) {
+            return chart;
+        }
+    }
+    return nullptr;
+}
+
+void ChartsPanel::startBuild() {
+    for (TimeSeriesChart* chart : m_charts) {
+        chart->clear();
+    }
+    m_clock.restart();
+    m_progress = {};
+    m_sortedHistory.clear();
+    m_building = true;
+}
+
+void ChartsPanel::setProgress(const PipelineProgress& progress) {
+    m_progress = progress;
+}
+
+void ChartsPanel::setHierarchyBytes(std::size_t bytes) {
+    m_hierarchyBytes = bytes;
+}
+
+void ChartsPanel::setFrame(double frameMs, double frontMs, double fps, std::size_t frontNodes) {
+    m_haveFrame = true;
+    m_frameMs = frameMs;
+    m_frontMs = frontMs;
+    m_lastFps = fps;
+    m_frontNodes = frontNodes;
+}
+
+double ChartsPanel::insertionDelaySeconds(double now) const {
+    for (const auto& [seconds, sorted] : m_sortedHistory) {
+        if (sorted >= m_progress.pointsInserted) {
+            return now - seconds;
+        }
+    }
+    return 0.0;
+}
+
+void ChartsPanel::sample() {
+    const double now = m_clock.nsecsElapsed() * 1e-9;
+    if (m_building) {
+        m_inserted->append(0, now, static_cast<double>(m_progress.pointsInserted));
+        m_inserted->append(1, now, static_cast<double>(m_progress.pointsSorted));
+        if (m_progress.pointsTotal > 0) {
+            m_inserted->setLine(
+                2, {QPointF(0.0, 0.0), QPointF(now, static_cast<double>(m_progress.pointsTotal))});
+        }
+        if (m_progress.pointsSorted > 0) {
+            m_sortedHistory.emplace_back(now, m_progress.pointsSorted);
+            if (m_progress.pointsInserted > 0) {
+                m_delay->append(0, now, insertionDelaySeconds(now));
+            }
+        }
+        const bool ended = m_progress.phase == BuildPhase::Complete ||
+                           m_progress.phase == BuildPhase::Cancelled ||
+                           m_progress.phase == BuildPhase::Failed;
+        if (ended && m_progress.generation != 0) {
+            m_building = false; // the build charts keep their last state
+        }
+    }
+    if (m_haveFrame) {
+        m_front->append(0, now, static_cast<double>(m_frontNodes));
+        m_cpu->append(0, now, m_frameMs);
+        m_cpu->append(1, now, m_frontMs);
+        m_fpsChart->append(0, now, m_lastFps);
+    }
+    m_memory->append(0, now, static_cast<double>(residentBytes()) / 1048576.0);
+    m_memory->append(1, now, static_cast<double>(m_hierarchyBytes) / 1048576.0);
+}
+
+} // namespace omicron

@@ -1,0 +1,524 @@
+#include "main_window.hpp"
+
+#include "build_panel.hpp"
+#include "builder_service.hpp"
+#include "charts_panel.hpp"
+#include "cut_panel.hpp"
+#include "process_memory.hpp"
+#include "ui_mainwindow.h"
+
+#include <QActionGroup>
+#include <QApplication>
+#include <QCloseEvent>
+#include <QDockWidget>
+#include <QDragEnterEvent>
+#include <QDropEvent>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QImage>
+#include <QLabel>
+#include <QLocale>
+#include <QMessageBox>
+#include <QMimeData>
+#include <QProgressBar>
+#include <QScreen>
+#include <QSettings>
+#include <QUrl>
+
+#include "cloud_view.hpp"
+
+namespace omicron {
+
+namespace {
+
+QString mib(std::size_t bytes) {
+    return QString::number(static_cast<double>(bytes) / 1048576.0, 'f', 0) + QStringLiteral(" MiB");
+}
+
+} // namespace
+
+MainWindow::MainWindow(QWidget* parent)
+    : QMainWindow(parent), m_ui(std::make_unique<Ui::MainWindow>()),
+      m_service(new BuilderService(this)) {
+    m_ui->setupUi(this);
+    setCentralWidget(createCentralView());
+    createDocks();
+
+    m_phaseLabel = new QLabel(this);
+    m_pointsLabel = new QLabel(this);
+    m_fpsLabel = new QLabel(this);
+    m_memoryLabel = new QLabel(this);
+    m_progressBar = new QProgressBar(this);
+    m_progressBar->setMaximum(1000);
+    m_progressBar->setMaximumWidth(160);
+    m_progressBar->setTextVisible(false);
+    m_progressBar->hide();
+    m_phaseLabel->setToolTip(tr("Build phase"));
+    m_pointsLabel->setToolTip(tr("Points drawn in the last frame / points of the cloud"));
+    m_fpsLabel->setToolTip(tr("Frames per second"));
+    m_memoryLabel->setToolTip(tr("Resident memory of the process"));
+    statusBar()->addPermanentWidget(m_progressBar);
+    statusBar()->addPermanentWidget(m_phaseLabel);
+    statusBar()->addPermanentWidget(m_pointsLabel);
+    statusBar()->addPermanentWidget(m_fpsLabel);
+    statusBar()->addPermanentWidget(m_memoryLabel);
+
+    connectActions();
+    connectService();
+    loadSettings();
+    updateRecentMenu();
+    updateActions();
+    // Memory and fps change without a build: refresh the status bar twice a second.
+    m_statusTimer.setInterval(500);
+    connect(&m_statusTimer, &QTimer::timeout, this, &MainWindow::updateStatus);
+    m_statusTimer.start();
+    updateStatus();
+}
+
+MainWindow::~MainWindow() {
+    // The service's worker may still post to it: stop it before the panels go.
+    m_service->shutdown();
+}
+
+// The one place the central widget is made: CloudView where the widget library is built.
+QWidget* MainWindow::createCentralView() {
+    m_view = new CloudView(this);
+    m_view->setObjectName(QStringLiteral("cloudView"));
+    m_view->setMinimumSize(320, 240);
+    return m_view;
+}
+
+void MainWindow::createDocks() {
+    const auto dock = [this](QWidget* panel, const QString& title, const QString& name,
+                             Qt::DockWidgetArea area) {
+        auto* widget = new QDockWidget(title, this);
+        widget->setObjectName(name); // saveState() keys docks by object name
+        widget->setWidget(panel);
+        addDockWidget(area, widget);
+        QAction* toggle = widget->toggleViewAction();
+        m_ui->menuPanels->addAction(toggle);
+        return widget;
+    };
+    m_buildPanel = new BuildPanel(this);
+    m_cutPanel = new CutPanel(this);
+    m_chartsPanel = new ChartsPanel(this);
+    dock(m_buildPanel, tr("Build"), QStringLiteral("buildDock"), Qt::LeftDockWidgetArea);
+    dock(m_cutPanel, tr("Cut progress"), QStringLiteral("cutDock"), Qt::RightDockWidgetArea);
+    dock(m_chartsPanel, tr("Charts"), QStringLiteral("chartsDock"), Qt::BottomDockWidgetArea);
+    m_ui->menuPanels->actions().at(0)->setShortcut(QKeySequence(tr("Ctrl+Shift+B")));
+    m_ui->menuPanels->actions().at(1)->setShortcut(QKeySequence(tr("Ctrl+Shift+U")));
+    m_ui->menuPanels->actions().at(2)->setShortcut(QKeySequence(tr("Ctrl+Shift+C")));
+}
+
+void MainWindow::connectActions() {
+    connect(m_ui->actionOpen, &QAction::triggered, this, [this] {
+        const QString path = QFileDialog::getOpenFileName(
+            this, tr("Open"), m_recentFiles.value(0),
+            tr("Point clouds and hierarchies (*.ply *.las *.xyz *.pts *.txt *.csv *.oms *.omh);;"
+               "Point clouds (*.ply *.las *.xyz *.pts *.txt *.csv);;"
+               "Sorted streams (*.oms);;Hierarchies (*.omh);;All files (*)"));
+        if (!path.isEmpty()) {
+            openFile(path);
+        }
+    });
+    connect(m_ui->actionOpenDefaultScene, &QAction::triggered, this,
+            [this] { openDefaultScene(); });
+    connect(m_ui->actionSaveHierarchy, &QAction::triggered, this, [this] {
+        const QString path = askSavePath(tr("Save Hierarchy As"), tr("Hierarchies (*.omh)"), "omh");
+        if (!path.isEmpty()) {
+            saveHierarchy(path);
+        }
+    });
+    connect(m_ui->actionExportSortedStream, &QAction::triggered, this, [this] {
+        const QString path =
+            askSavePath(tr("Export Sorted Stream"), tr("Sorted streams (*.oms)"), "oms");
+        if (!path.isEmpty()) {
+            exportSortedStream(path);
+        }
+    });
+    connect(m_ui->actionExportPoints, &QAction::triggered, this, [this] {
+        const QString path =
+            askSavePath(tr("Export Points"), tr("PLY (*.ply);;LAS (*.las)"), "ply");
+        if (!path.isEmpty()) {
+            exportPoints(path);
+        }
+    });
+    connect(m_ui->actionSaveScreenshot, &QAction::triggered, this, [this] {
+        const QString path = askSavePath(tr("Save Screenshot"), tr("PNG images (*.png)"), "png");
+        if (!path.isEmpty() && !saveScreenshot(path)) {
+            showError(path, tr("%1: cannot write the screenshot").arg(path));
+        }
+    });
+    connect(m_ui->actionClearRecent, &QAction::triggered, this, [this] {
+        m_recentFiles.clear();
+        updateRecentMenu();
+    });
+    connect(m_ui->actionQuit, &QAction::triggered, this, &QWidget::close);
+    connect(m_ui->actionRebuild, &QAction::triggered, m_buildPanel, &BuildPanel::requestRebuild);
+    connect(m_ui->actionCancel, &QAction::triggered, m_service, &BuilderService::cancel);
+    connect(m_ui->actionShortcuts, &QAction::triggered, this, &MainWindow::showShortcuts);
+    connect(m_ui->actionAbout, &QAction::triggered, this, &MainWindow::showAbout);
+
+    connect(m_buildPanel, &BuildPanel::rebuildRequested, this, [this](const BuildOptions& options) {
+        m_service->setOptions(m_buildPanel->pipelineOptions());
+        m_service->rebuild(options);
+    });
+    connect(m_buildPanel, &BuildPanel::cancelRequested, m_service, &BuilderService::cancel);
+    connect(m_buildPanel, &BuildPanel::viewParametersChanged, this,
+            &MainWindow::applyViewParameters);
+    connect(m_chartsPanel, &ChartsPanel::exportFailed, this, &MainWindow::showError);
+
+    auto* renderModes = new QActionGroup(this);
+    renderModes->addAction(m_ui->actionPoints);
+    renderModes->addAction(m_ui->actionSplats);
+    auto* colorModes = new QActionGroup(this);
+    for (QAction* action : m_ui->menuColorMode->actions()) {
+        colorModes->addAction(action);
+    }
+    m_ui->actionPoints->setChecked(true);
+    m_ui->actionColorRgb->setChecked(true);
+    m_ui->actionShowCutBoundary->setChecked(true);
+    m_ui->actionShowAxes->setChecked(true);
+
+    const auto editSettings = [this](auto&& edit) {
+        RenderSettings settings = m_view->renderSettings();
+        edit(settings);
+        m_view->setRenderSettings(settings);
+    };
+    connect(m_ui->actionPoints, &QAction::triggered, this, [this] {
+        ViewParameters parameters = m_buildPanel->viewParameters();
+        parameters.splats = false;
+        m_buildPanel->setViewParameters(parameters);
+    });
+    connect(m_ui->actionSplats, &QAction::triggered, this, [this] {
+        ViewParameters parameters = m_buildPanel->viewParameters();
+        parameters.splats = true;
+        m_buildPanel->setViewParameters(parameters);
+    });
+    const std::pair<QAction*, ColorMode> colors[] = {
+        {m_ui->actionColorRgb, ColorMode::Rgb},
+        {m_ui->actionColorNormal, ColorMode::Normal},
+        {m_ui->actionColorHeight, ColorMode::Height},
+        {m_ui->actionColorIntensity, ColorMode::Intensity},
+        {m_ui->actionColorLevel, ColorMode::Level},
+        {m_ui->actionColorBuildAge, ColorMode::BuildAge}};
+    for (const auto& [action, mode] : colors) {
+        connect(action, &QAction::triggered, this, [editSettings, mode = mode] {
+            editSettings([&](RenderSettings& s) { s.color = mode; });
+        });
+    }
+    connect(m_ui->actionPointSizeLarger, &QAction::triggered, this, [editSettings] {
+        editSettings([](RenderSettings& s) {
+            s.pointSizeScale = std::min(16.0f, s.pointSizeScale * 1.25f);
+        });
+    });
+    connect(m_ui->actionPointSizeSmaller, &QAction::triggered, this, [editSettings] {
+        editSettings(
+            [](RenderSettings& s) { s.pointSizeScale = std::max(0.1f, s.pointSizeScale / 1.25f); });
+    });
+    connect(m_ui->actionPointSizeReset, &QAction::triggered, this,
+            [editSettings] { editSettings([](RenderSettings& s) { s.pointSizeScale = 1.0f; }); });
+    connect(m_ui->actionShowOctreeCells, &QAction::toggled, this, [editSettings](bool on) {
+        editSettings([on](RenderSettings& s) { s.showOctreeCells = on; });
+    });
+    connect(m_ui->actionShowCutBoundary, &QAction::toggled, this, [editSettings](bool on) {
+        editSettings([on](RenderSettings& s) { s.showCutBoundary = on; });
+    });
+    connect(m_ui->actionShowAxes, &QAction::toggled, this, [editSettings](bool on) {
+        editSettings([on](RenderSettings& s) { s.showAxes = on; });
+    });
+    connect(m_ui->actionFit, &QAction::triggered, m_view, &CloudView::fitToCloud);
+    const std::pair<QAction*, StandardView> views[] = {
+        {m_ui->actionViewTop, StandardView::Top},
+        {m_ui->actionViewBottom, StandardView::Bottom},
+        {m_ui->actionViewFront, StandardView::Front},
+        {m_ui->actionViewBack, StandardView::Back},
+        {m_ui->actionViewLeft, StandardView::Left},
+        {m_ui->actionViewRight, StandardView::Right},
+        {m_ui->actionViewIso, StandardView::Iso}};
+    for (const auto& [action, standard] : views) {
+        connect(action, &QAction::triggered, m_view,
+                [this, standard = standard] { m_view->setStandardView(standard); });
+    }
+    connect(m_ui->actionFlyMode, &QAction::toggled, m_view, &CloudView::setFlyMode);
+    connect(m_view, &CloudView::flyModeChanged, m_ui->actionFlyMode, &QAction::setChecked);
+    connect(m_view, &CloudView::frameRendered, this, [this](const FrameStats& stats) {
+        m_chartsPanel->setFrame(stats.frameMs, stats.frontMs, stats.fps, stats.frontNodes);
+        m_pointsDrawn = stats.pointsDrawn;
+        m_fps = stats.fps;
+    });
+}
+
+void MainWindow::connectService() {
+    connect(m_service, &BuilderService::buildStarted, this, [this](const QString& title) {
+        m_title = title;
+        setWindowTitle(tr("%1 — omicron").arg(title));
+        m_chartsPanel->startBuild();
+        m_progressBar->setValue(0);
+        m_progressBar->show();
+    });
+    connect(m_service, &BuilderService::progressChanged, this,
+            [this](const PipelineProgress& progress) {
+                m_progress = progress;
+                m_cutPanel->setProgress(progress);
+                m_chartsPanel->setProgress(progress);
+                // Read, sort and insert each take a third of the bar.
+                const double total = std::max<double>(1.0, double(progress.pointsTotal));
+                m_progressBar->setValue(static_cast<int>(
+                    1000.0 *
+                    (progress.pointsRead + progress.pointsSorted + progress.pointsInserted) /
+                    (3.0 * total)));
+                updateStatus();
+            });
+    connect(m_service, &BuilderService::statisticsChanged, this,
+            [this](const BuildStatistics& statistics) {
+                m_cutPanel->setStatistics(statistics);
+                m_chartsPanel->setHierarchyBytes(statistics.bytesResident());
+            });
+    connect(m_service, &BuilderService::hierarchyChanged, this,
+            [this](std::shared_ptr<const Hierarchy> hierarchy) {
+                m_view->setHierarchy(std::move(hierarchy));
+            });
+    connect(m_service, &BuilderService::previewChanged, this,
+            [this](const PreviewSample& preview, const CubeTransform& cube) {
+                m_view->setPreview(preview, cube);
+            });
+    connect(m_service, &BuilderService::buildFinished, this, [this](const PipelineResult& result) {
+        const QLocale locale;
+        statusBar()->showMessage(
+            result.cancelled ? tr("Build of %1 cancelled").arg(m_title)
+                             : tr("%1: %2 points, %3 nodes in %4 s")
+                                   .arg(m_title, locale.toString(quint64(result.stats.inputPoints)),
+                                        locale.toString(quint64(result.stats.totalNodes())))
+                                   .arg(result.stats.creationSeconds, 0, 'f', 2),
+            10000);
+    });
+    connect(m_service, &BuilderService::jobFinished, this,
+            [this](const QString& message) { statusBar()->showMessage(message, 10000); });
+    connect(m_service, &BuilderService::failed, this, &MainWindow::showError);
+    connect(m_service, &BuilderService::busyChanged, this, [this](bool busy) {
+        m_buildPanel->setBusy(busy);
+        m_progressBar->setVisible(busy);
+        updateActions();
+    });
+}
+
+void MainWindow::openFile(const QString& path) {
+    const QFileInfo info(path);
+    if (info.suffix().compare(QStringLiteral("omh"), Qt::CaseInsensitive) == 0) {
+        m_service->openHierarchy(path);
+    } else {
+        m_service->setOptions(m_buildPanel->pipelineOptions());
+        m_service->open(path);
+    }
+    addRecentFile(info.absoluteFilePath());
+}
+
+void MainWindow::openDefaultScene(quint64 points) {
+    m_service->setOptions(m_buildPanel->pipelineOptions());
+    m_service->openGeneratedScene(points, kDefaultSceneSeed);
+}
+
+void MainWindow::saveHierarchy(const QString& path) {
+    m_service->saveHierarchy(path);
+}
+
+void MainWindow::exportSortedStream(const QString& path) {
+    m_service->exportSortedStream(path);
+}
+
+void MainWindow::exportPoints(const QString& path) {
+    m_service->exportPoints(path);
+}
+
+bool MainWindow::saveScreenshot(const QString& path) {
+    const QImage image = m_view->renderImage(m_view->size() * m_view->devicePixelRatio());
+    return !image.isNull() && image.save(path);
+}
+
+QMessageBox* MainWindow::errorDialog() const {
+    return findChild<QMessageBox*>(QStringLiteral("errorDialog"));
+}
+
+void MainWindow::showError(const QString& path, const QString& message) {
+    // Window-modal and opened with open(), not exec(): the event loop (and a running build)
+    // goes on, and tests can find the dialog by name and close it.
+    if (QMessageBox* previous = errorDialog()) {
+        previous->close();
+        previous->deleteLater();
+        previous->setObjectName(QString());
+    }
+    auto* box =
+        new QMessageBox(QMessageBox::Critical, tr("omicron"),
+                        path.isEmpty() ? tr("The operation failed.")
+                                       : tr("Cannot use %1").arg(QFileInfo(path).fileName()),
+                        QMessageBox::Ok, this);
+    box->setObjectName(QStringLiteral("errorDialog"));
+    box->setInformativeText(message);
+    box->setAttribute(Qt::WA_DeleteOnClose);
+    box->setWindowModality(Qt::WindowModal);
+    box->open();
+    statusBar()->showMessage(message, 10000);
+}
+
+void MainWindow::closeEvent(QCloseEvent* event) {
+    // Cancel first so the join in shutdown() waits only for the next cancellation check.
+    m_service->shutdown();
+    saveSettings();
+    event->accept();
+}
+
+void MainWindow::dragEnterEvent(QDragEnterEvent* event) {
+    if (event->mimeData()->hasUrls() && !event->mimeData()->urls().isEmpty() &&
+        event->mimeData()->urls().first().isLocalFile()) {
+        event->acceptProposedAction();
+    }
+}
+
+void MainWindow::dropEvent(QDropEvent* event) {
+    const QList<QUrl> urls = event->mimeData()->urls();
+    if (!urls.isEmpty() && urls.first().isLocalFile()) {
+        openFile(urls.first().toLocalFile());
+        event->acceptProposedAction();
+    }
+}
+
+void MainWindow::loadSettings() {
+    QSettings settings;
+    restoreGeometry(settings.value("window/geometry").toByteArray());
+    restoreState(settings.value("window/state").toByteArray());
+    m_recentFiles = settings.value("recentFiles").toStringList();
+    while (m_recentFiles.size() > kMaxRecentFiles) {
+        m_recentFiles.removeLast();
+    }
+    m_buildPanel->loadSettings(settings);
+    applyViewParameters(m_buildPanel->viewParameters());
+}
+
+void MainWindow::saveSettings() const {
+    QSettings settings;
+    settings.setValue("window/geometry", saveGeometry());
+    settings.setValue("window/state", saveState());
+    settings.setValue("recentFiles", m_recentFiles);
+    m_buildPanel->saveSettings(settings);
+}
+
+void MainWindow::addRecentFile(const QString& path) {
+    m_recentFiles.removeAll(path);
+    m_recentFiles.prepend(path);
+    while (m_recentFiles.size() > kMaxRecentFiles) {
+        m_recentFiles.removeLast();
+    }
+    updateRecentMenu();
+    QSettings().setValue("recentFiles", m_recentFiles);
+}
+
+void MainWindow::updateRecentMenu() {
+    QMenu* menu = m_ui->menuOpenRecent;
+    for (QAction* action : menu->actions()) {
+        if (action != m_ui->actionClearRecent) {
+            menu->removeAction(action);
+            action->deleteLater();
+        }
+    }
+    QAction* before = m_ui->actionClearRecent;
+    for (int i = 0; i < m_recentFiles.size(); ++i) {
+        const QString path = m_recentFiles.at(i);
+        auto* action = new QAction(
+            QStringLiteral("&%1 %2").arg((i + 1) % 10).arg(QFileInfo(path).fileName()), menu);
+        action->setToolTip(path);
+        action->setStatusTip(path);
+        connect(action, &QAction::triggered, this, [this, path] { openFile(path); });
+        menu->insertAction(before, action);
+    }
+    if (!m_recentFiles.isEmpty()) {
+        menu->insertSeparator(before);
+    }
+    menu->setEnabled(!m_recentFiles.isEmpty());
+}
+
+void MainWindow::updateActions() {
+    const bool busy = m_service->busy();
+    m_ui->actionCancel->setEnabled(busy);
+    // Exports need the whole sorted list; the service also refuses them with a message.
+    const bool haveCloud = m_service->hasCompleteCloud();
+    m_ui->actionExportSortedStream->setEnabled(haveCloud);
+    m_ui->actionExportPoints->setEnabled(haveCloud);
+    m_ui->actionSaveHierarchy->setEnabled(m_service->hierarchy() != nullptr);
+}
+
+void MainWindow::updateStatus() {
+    const QLocale locale;
+    m_phaseLabel->setText(QString::fromLatin1(toString(m_progress.phase)));
+    m_pointsLabel->setText(tr("%1 / %2 points")
+                               .arg(locale.toString(quint64(m_pointsDrawn)),
+                                    locale.toString(quint64(m_progress.pointsTotal))));
+    m_fpsLabel->setText(tr("%1 fps").arg(m_fps, 0, 'f', 1));
+    m_memoryLabel->setText(mib(residentBytes()));
+}
+
+void MainWindow::applyViewParameters(const ViewParameters& parameters) {
+    m_ui->actionPoints->setChecked(!parameters.splats);
+    m_ui->actionSplats->setChecked(parameters.splats);
+    RenderSettings settings = m_view->renderSettings();
+    settings.projectionThresholdPx = parameters.projectionThresholdPx;
+    settings.pointBudget = parameters.pointBudget;
+    settings.mode = parameters.splats ? RenderMode::Splats : RenderMode::Points;
+    m_view->setRenderSettings(settings);
+}
+
+QString MainWindow::askSavePath(const QString& title, const QString& filter,
+                                const QString& suffix) {
+    QFileDialog dialog(this, title,
+                       m_recentFiles.isEmpty() ? QString()
+                                               : QFileInfo(m_recentFiles.first()).absolutePath(),
+                       filter);
+    dialog.setAcceptMode(QFileDialog::AcceptSave);
+    dialog.setDefaultSuffix(suffix);
+    return dialog.exec() == QDialog::Accepted && !dialog.selectedFiles().isEmpty()
+               ? dialog.selectedFiles().first()
+               : QString();
+}
+
+void MainWindow::showShortcuts() {
+    QString rows;
+    const auto addMenu = [&](QMenu* menu, auto&& self) -> void {
+        for (QAction* action : menu->actions()) {
+            if (action->menu() != nullptr) {
+                self(action->menu(), self);
+            } else if (!action->shortcut().isEmpty()) {
+                rows +=
+                    QStringLiteral("<tr><td>%1</td><td>%2</td></tr>")
+                        .arg(action->shortcut().toString(QKeySequence::NativeText).toHtmlEscaped(),
+                             action->text().remove(QLatin1Char('&')).toHtmlEscaped());
+            }
+        }
+    };
+    for (QMenu* menu : {m_ui->menuFile, m_ui->menuBuild, m_ui->menuView, m_ui->menuHelp}) {
+        addMenu(menu, addMenu);
+    }
+    rows += tr("<tr><td>Left drag</td><td>Orbit</td></tr>"
+               "<tr><td>Right / middle drag</td><td>Pan</td></tr>"
+               "<tr><td>Wheel</td><td>Zoom</td></tr>"
+               "<tr><td>Double click</td><td>Centre on the point</td></tr>"
+               "<tr><td>W A S D Q E (fly mode)</td><td>Fly</td></tr>");
+    auto* box = new QMessageBox(QMessageBox::Information, tr("Keyboard shortcuts"),
+                                QStringLiteral("<table cellspacing=4>%1</table>").arg(rows),
+                                QMessageBox::Close, this);
+    box->setObjectName(QStringLiteral("shortcutsDialog"));
+    box->setAttribute(Qt::WA_DeleteOnClose);
+    box->open();
+}
+
+void MainWindow::showAbout() {
+    QMessageBox::about(
+        this, tr("About omicron"),
+        tr("<h3>omicron %1</h3><p>Look at huge point clouds while their level-of-detail octree "
+           "is being built: an implementation of <i>OMiCroN — Oblique Multipass Hierarchy "
+           "Creation while Navigating</i>.</p><p>Pipelines: unsorted cloud → incremental "
+           "Morton sorter → parallel oblique-cut builder; sorted stream (.oms) → builder; "
+           "hierarchy file (.omh).</p>")
+            .arg(QApplication::applicationVersion()));
+}
+
+} // namespace omicron

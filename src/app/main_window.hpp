@@ -1,0 +1,100 @@
+// MainWindow: the desktop application's window (form ui/mainwindow.ui). CloudView in the
+// centre, dockable panels (build parameters, cut progress, live charts), menus, drag and
+// drop, a status bar; geometry, docks, recent files and parameters persist in QSettings.
+// Every long job runs in the BuilderService; failures come back as its failed() signal and
+// are shown in a window-modal dialog (objectName "errorDialog") while the view is kept.
+#pragma once
+
+#include "build_pipeline.hpp"
+#include "view_parameters.hpp"
+
+#include <QMainWindow>
+#include <QStringList>
+#include <QTimer>
+#include <memory>
+
+class QLabel;
+class QMessageBox;
+class QProgressBar;
+
+namespace Ui {
+class MainWindow;
+}
+
+namespace omicron {
+
+class BuilderService;
+class BuildPanel;
+class ChartsPanel;
+class CloudView;
+class CutPanel;
+
+class MainWindow : public QMainWindow {
+    Q_OBJECT
+public:
+    static constexpr int kMaxRecentFiles = 10;
+
+    explicit MainWindow(QWidget* parent = nullptr);
+    ~MainWindow() override;
+
+    BuilderService* service() const { return m_service; }
+    BuildPanel* buildPanel() const { return m_buildPanel; }
+    CutPanel* cutPanel() const { return m_cutPanel; }
+    ChartsPanel* chartsPanel() const { return m_chartsPanel; }
+    // The central CloudView.
+    CloudView* cloudView() const { return m_view; }
+    QStringList recentFiles() const { return m_recentFiles; }
+    // The error dialog currently shown (nullptr when none).
+    QMessageBox* errorDialog() const;
+
+public slots:
+    // What File -> Open does after its dialog: pipeline 1 (PLY/LAS/XYZ), 2 (.oms) or 3 (.omh).
+    void openFile(const QString& path);
+    void openDefaultScene(quint64 points = kDefaultScenePoints);
+    void saveHierarchy(const QString& path);
+    void exportSortedStream(const QString& path);
+    void exportPoints(const QString& path);
+    bool saveScreenshot(const QString& path);
+    void showError(const QString& path, const QString& message);
+
+protected:
+    void closeEvent(QCloseEvent* event) override;
+    void dragEnterEvent(QDragEnterEvent* event) override;
+    void dropEvent(QDropEvent* event) override;
+
+private:
+    QWidget* createCentralView();
+    void createDocks();
+    void connectActions();
+    void connectService();
+    void loadSettings();
+    void saveSettings() const;
+    void addRecentFile(const QString& path);
+    void updateRecentMenu();
+    void updateActions();
+    void updateStatus();
+    void applyViewParameters(const ViewParameters& parameters);
+    void showShortcuts();
+    void showAbout();
+    QString askSavePath(const QString& title, const QString& filter, const QString& suffix);
+
+    std::unique_ptr<Ui::MainWindow> m_ui;
+    BuilderService* m_service = nullptr;
+    CloudView* m_view = nullptr;
+    BuildPanel* m_buildPanel = nullptr;
+    CutPanel* m_cutPanel = nullptr;
+    ChartsPanel* m_chartsPanel = nullptr;
+    QStringList m_recentFiles;
+    QString m_title; // what is shown: file name or "generated scene"
+    PipelineProgress m_progress;
+    QLabel* m_phaseLabel = nullptr;
+    QLabel* m_pointsLabel = nullptr;
+    QLabel* m_fpsLabel = nullptr;
+    QLabel* m_memoryLabel = nullptr;
+    QProgressBar* m_progressBar = nullptr;
+    QTimer m_statusTimer;
+    std::size_t m_pointsDrawn = 0;
+    double m_fps = 0.0;
+};
+
+} // namespace omicron

@@ -1,0 +1,304 @@
+// BuilderService: opens real files through the entry File -> Open uses, reports monotonic
+// progress at <= 10 Hz, rebuilds without reading again, exports what loads back identically,
+// reports bad files by name, and stops promptly on cancel and destruction.
+#include "app_test_support.hpp"
+#include "builder_service.hpp"
+#include "point_reader.hpp"
+
+#include <QElapsedTimer>
+#include <QFile>
+#include <QFile>
+#include <QFileInfo>
+#include <QSignalSpy>
+#include <QTemporaryDir>
+#include <QtTest>
+
+using namespace omicron;
+
+namespace {
+
+constexpr int kBuildTimeoutMs = 120'000;
+
+PipelineOptions testOptions(int depth = 6) {
+    PipelineOptions options;
+    options.build.maxLevel = depth;
+    options.build.checkInvariants = true;
+    options.sortChunks = 8;
+    return options;
+}
+
+PipelineResult waitForBuild(QSignalSpy& finished, QSignalSpy& failed) {
+    [&] {
+        QTRY_VERIFY_WITH_TIMEOUT(finished.count() + failed.count() > 0, kBuildTimeoutMs);
+    }();
+    if (failed.count() > 0) {
+        qWarning() << "build failed:" << failed.first();
+        return {};
+    }
+    return finished.takeFirst().at(0).value<PipelineResult>();
+}
+
+void expectSameLevels(const BuildStatistics& a, const BuildStatistics& b) {
+    QCOMPARE(a.levels.size(), b.levels.size());
+    for (std::size_t level = 0; level < a.levels.size(); ++level) {
+        QCOMPARE(a.levels[level].nodes, b.levels[level].nodes);
+        QCOMPARE(a.levels[level].points, b.levels[level].points);
+    }
+}
+
+} // namespace
+
+class TestBuilderService : public QObject {
+    Q_OBJECT
+private slots:
+    void openSharedFileReportsMonotonicThrottledProgress();
+    void rebuildReusesTheSortedDataWithoutReading();
+    void malformedFileIsReportedByNameAndTheHierarchyIsKept();
+    void exportsLoadBackIdentically();
+    void savedHierarchyLoadsBackWithIdenticalStatistics();
+    void cancelMidBuildEndsTheRun();
+    void destroyingMidBuildJoinsEveryThread();
+    void newOpenWhileBusyReplacesTheRunningBuild();
+};
+
+void TestBuilderService::openSharedFileReportsMonotonicThrottledProgress() {
+    OMICRON_REQUIRE_SHARED_FILE(path, "autzen_trim.las");
+    BuilderService service;
+    service.setOptions(testOptions(7));
+    QSignalSpy started(&service, &BuilderService::buildStarted);
+    QSignalSpy progress(&service, &BuilderService::progressChanged);
+    QSignalSpy statistics(&service, &BuilderService::statisticsChanged);
+    QSignalSpy hierarchy(&service, &BuilderService::hierarchyChanged);
+    QSignalSpy finished(&service, &BuilderService::buildFinished);
+    QSignalSpy failed(&service, &BuilderService::failed);
+    QElapsedTimer clock;
+    clock.start();
+    service.open(path);
+    QVERIFY(service.busy());
+    QCOMPARE(started.count(), 1);
+    QCOMPARE(started.first().at(0).toString(), QStringLiteral("autzen_trim.las"));
+    const PipelineResult result = waitForBuild(finished, failed);
+    const double seconds = clock.elapsed() / 1000.0;
+    QVERIFY(result.stats.complete);
+    QVERIFY2(result.stats.invariantViolation.empty(), result.stats.invariantViolation.c_str());
+    QCOMPARE(result.source.kind, PipelineKind::UnsortedCloud);
+    QTRY_VERIFY(!service.busy());
+    QVERIFY(hierarchy.count() >= 1);
+    QVERIFY(statistics.count() >= 1);
+    QVERIFY(progress.count() >= 1);
+    // <= 10 Hz: one per 100 ms tick, plus the final poll when the worker returns.
+    QVERIFY2(progress.count() <= seconds * 10.0 + 2.0,
+             qPrintable(
+                 QStringLiteral("%1 progress signals in %2 s").arg(progress.count()).arg(seconds)));
+    PipelineProgress previous;
+    for (const QList<QVariant>& signal : progress) {
+        const auto p = signal.at(0).value<PipelineProgress>();
+        QVERIFY(static_cast<int>(p.phase) >= static_cast<int>(previous.phase));
+        QVERIFY(p.pointsRead >= previous.pointsRead);
+        QVERIFY(p.pointsSorted >= previous.pointsSorted);
+        QVERIFY(p.pointsInserted >= previous.pointsInserted);
+        QVERIFY(p.cutDelimiter >= previous.cutDelimiter);
+        previous = p;
+    }
+    QCOMPARE(previous.phase, BuildPhase::Complete);
+    QCOMPARE(previous.pointsInserted, result.source.pointCount);
+    QCOMPARE(service.sourceReads(), 1u);
+}
+
+void TestBuilderService::rebuildReusesTheSortedDataWithoutReading() {
+    OMICRON_REQUIRE_SHARED_FILE(path, "bunny.ply");
+    BuilderService service;
+    service.setOptions(testOptions(6));
+    QSignalSpy finished(&service, &BuilderService::buildFinished);
+    QSignalSpy failed(&service, &BuilderService::failed);
+    service.open(path);
+    const PipelineResult first = waitForBuild(finished, failed);
+    QVERIFY(first.stats.complete);
+    QTRY_VERIFY(!service.busy());
+    QCOMPARE(service.sourceReads(), 1u);
+    const auto firstHierarchy = service.hierarchy();
+
+    BuildOptions deeper = testOptions(9).build;
+    deeper.collapse = LeafCollapse::Paper;
+    deeper.ratio = 0.25;
+    QVERIFY(service.rebuild(deeper));
+    const PipelineResult second = waitForBuild(finished, failed);
+    QVERIFY(second.stats.complete);
+    QCOMPARE(service.sourceReads(), 1u); // no re-read, no re-sort
+    QVERIFY(service.hierarchy() != firstHierarchy);
+    QCOMPARE(service.hierarchy()->maxLevel(), 9);
+    QCOMPARE(second.stats.levels.size(), std::size_t{10});
+    QVERIFY(second.stats.droppedPoints > 0); // the paper's collapse did act
+}
+
+void TestBuilderService::malformedFileIsReportedByNameAndTheHierarchyIsKept() {
+    QTemporaryDir dir;
+    BuilderService service;
+    service.setOptions(testOptions(5));
+    QSignalSpy finished(&service, &BuilderService::buildFinished);
+    QSignalSpy failed(&service, &BuilderService::failed);
+    service.openGeneratedScene(20'000, 2);
+    QVERIFY(waitForBuild(finished, failed).stats.complete);
+    QTRY_VERIFY(!service.busy());
+    const auto kept = service.hierarchy();
+
+    const QString bad = dir.filePath(QStringLiteral("broken.las"));
+    QFile file(bad);
+    QVERIFY(file.open(QIODevice::WriteOnly));
+    file.write("LASF this is not a LAS header");
+    file.close();
+    service.open(bad);
+    QTRY_VERIFY_WITH_TIMEOUT(failed.count() == 1, kBuildTimeoutMs);
+    QCOMPARE(failed.first().at(0).toString(), bad);
+    QVERIFY2(failed.first().at(1).toString().contains(bad),
+             qPrintable(failed.first().at(1).toString()));
+    QTRY_VERIFY(!service.busy());
+    QCOMPARE(service.hierarchy(), kept);
+    QCOMPARE(finished.count(), 0);
+    // Still usable: the kept cloud rebuilds.
+    failed.clear();
+    QVERIFY(service.rebuild(testOptions(6).build));
+    QVERIFY(waitForBuild(finished, failed).stats.complete);
+}
+
+void TestBuilderService::exportsLoadBackIdentically() {
+    OMICRON_REQUIRE_SHARED_FILE(path, "bunny.ply");
+    QTemporaryDir dir;
+    BuilderService service;
+    service.setOptions(testOptions(6));
+    QSignalSpy finished(&service, &BuilderService::buildFinished);
+    QSignalSpy failed(&service, &BuilderService::failed);
+    QSignalSpy jobs(&service, &BuilderService::jobFinished);
+    service.open(path);
+    const PipelineResult original = waitForBuild(finished, failed);
+    QTRY_VERIFY(!service.busy());
+
+    const QString oms = dir.filePath(QStringLiteral("bunny.oms"));
+    QVERIFY(service.exportSortedStream(oms));
+    QTRY_VERIFY_WITH_TIMEOUT(jobs.count() == 1, kBuildTimeoutMs);
+    QTRY_VERIFY(!service.busy());
+    const QString las = dir.filePath(QStringLiteral("bunny.las"));
+    QVERIFY(service.exportPoints(las));
+    QTRY_VERIFY_WITH_TIMEOUT(jobs.count() == 2, kBuildTimeoutMs);
+    QTRY_VERIFY(!service.busy());
+    QCOMPARE(failed.count(), 0);
+    QCOMPARE(loadPointCloud(las.toStdString()).points.size(), original.source.pointCount);
+
+    // Pipeline 2 from the exported stream: the same hierarchy.
+    service.open(oms);
+    const PipelineResult reloaded = waitForBuild(finished, failed);
+    QCOMPARE(reloaded.source.kind, PipelineKind::SortedStream);
+    expectSameLevels(original.stats, reloaded.stats);
+
+    // A bad target names the file.
+    QTRY_VERIFY(!service.busy());
+    const QString badTarget = dir.filePath(QStringLiteral("points.txt"));
+    QVERIFY(service.exportPoints(badTarget));
+    QTRY_VERIFY_WITH_TIMEOUT(failed.count() == 1, kBuildTimeoutMs);
+    QVERIFY(failed.first().at(1).toString().contains(badTarget));
+}
+
+// Save Hierarchy As (.omh) then File > Open of that file: pipeline 3 gives the same counts.
+void TestBuilderService::savedHierarchyLoadsBackWithIdenticalStatistics() {
+    OMICRON_REQUIRE_SHARED_FILE(path, "bunny.ply");
+    QTemporaryDir dir;
+    BuilderService service;
+    service.setOptions(testOptions(6));
+    QSignalSpy finished(&service, &BuilderService::buildFinished);
+    QSignalSpy failed(&service, &BuilderService::failed);
+    QSignalSpy jobs(&service, &BuilderService::jobFinished);
+    QSignalSpy hierarchies(&service, &BuilderService::hierarchyChanged);
+    service.open(path);
+    const PipelineResult original = waitForBuild(finished, failed);
+    QTRY_VERIFY(!service.busy());
+
+    const QString omh = dir.filePath(QStringLiteral("bunny.omh"));
+    QVERIFY(service.saveHierarchy(omh));
+    QTRY_VERIFY_WITH_TIMEOUT(jobs.count() == 1, kBuildTimeoutMs);
+    QTRY_VERIFY(!service.busy());
+    QCOMPARE(failed.count(), 0);
+    QVERIFY(QFileInfo(omh).size() > 0);
+
+    hierarchies.clear();
+    service.openHierarchy(omh);
+    const PipelineResult loaded = waitForBuild(finished, failed);
+    QCOMPARE(loaded.source.kind, PipelineKind::HierarchyFile);
+    QVERIFY(loaded.stats.complete);
+    QCOMPARE(loaded.stats.inputPoints, original.stats.inputPoints);
+    expectSameLevels(original.stats, loaded.stats);
+    QTRY_VERIFY(hierarchies.count() > 0); // the view gets the loaded hierarchy
+    const auto hierarchy = hierarchies.last().at(0).value<std::shared_ptr<const Hierarchy>>();
+    QVERIFY(hierarchy != nullptr);
+    for (int level = 0; level <= hierarchy->maxLevel(); ++level) {
+        QCOMPARE(hierarchy->nodeCount(level), original.stats.levels[level].nodes);
+    }
+
+    // A damaged file is reported by name; the loaded hierarchy stays.
+    QTRY_VERIFY(!service.busy());
+    const QString damaged = dir.filePath(QStringLiteral("damaged.omh"));
+    QVERIFY(QFile::copy(omh, damaged));
+    QVERIFY(QFile::resize(damaged, QFileInfo(damaged).size() / 2));
+    service.openHierarchy(damaged);
+    QTRY_VERIFY_WITH_TIMEOUT(failed.count() == 1, kBuildTimeoutMs);
+    QVERIFY(failed.first().at(1).toString().contains(QStringLiteral("damaged.omh")));
+}
+
+void TestBuilderService::cancelMidBuildEndsTheRun() {
+    BuilderService service;
+    service.setOptions(testOptions(8));
+    QSignalSpy finished(&service, &BuilderService::buildFinished);
+    QSignalSpy failed(&service, &BuilderService::failed);
+    QSignalSpy progress(&service, &BuilderService::progressChanged);
+    service.openGeneratedScene(3'000'000, 5);
+    QTRY_VERIFY_WITH_TIMEOUT(progress.count() > 0, kBuildTimeoutMs);
+    QElapsedTimer clock;
+    clock.start();
+    service.cancel();
+    const PipelineResult result = waitForBuild(finished, failed);
+    QVERIFY(result.cancelled);
+    QVERIFY(!result.stats.complete);
+    QVERIFY2(clock.elapsed() < 10'000, qPrintable(QString::number(clock.elapsed())));
+    QTRY_VERIFY(!service.busy());
+    QVERIFY(!service.hasCompleteCloud());
+}
+
+void TestBuilderService::destroyingMidBuildJoinsEveryThread() {
+    std::weak_ptr<const Hierarchy> hierarchy;
+    QElapsedTimer clock;
+    {
+        BuilderService service;
+        service.setOptions(testOptions(8));
+        QSignalSpy progress(&service, &BuilderService::hierarchyChanged);
+        service.openGeneratedScene(3'000'000, 6);
+        QTRY_VERIFY_WITH_TIMEOUT(progress.count() > 0, kBuildTimeoutMs);
+        hierarchy = service.hierarchy();
+        QVERIFY(!hierarchy.expired());
+        QVERIFY(service.busy());
+        clock.start();
+    } // ~BuilderService: cancel, join the worker; the builder joins its master thread
+    QVERIFY2(clock.elapsed() < 10'000, qPrintable(QString::number(clock.elapsed())));
+    // The hierarchy (owned by the builder and the pipeline only) is gone: nothing still runs
+    // that could hold it.
+    QVERIFY(hierarchy.expired());
+}
+
+void TestBuilderService::newOpenWhileBusyReplacesTheRunningBuild() {
+    OMICRON_REQUIRE_SHARED_FILE(path, "bunny.ply");
+    BuilderService service;
+    service.setOptions(testOptions(6));
+    QSignalSpy finished(&service, &BuilderService::buildFinished);
+    QSignalSpy failed(&service, &BuilderService::failed);
+    QSignalSpy started(&service, &BuilderService::buildStarted);
+    service.openGeneratedScene(3'000'000, 7);
+    service.open(path); // never waits on the GUI thread
+    QTRY_VERIFY_WITH_TIMEOUT(started.count() == 2, kBuildTimeoutMs);
+    QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 2, kBuildTimeoutMs);
+    QVERIFY(finished.at(0).at(0).value<PipelineResult>().cancelled);
+    const auto last = finished.at(1).at(0).value<PipelineResult>();
+    QVERIFY(last.stats.complete);
+    QCOMPARE(QString::fromStdString(last.source.path), path);
+    QCOMPARE(failed.count(), 0);
+}
+
+QTEST_MAIN(TestBuilderService)
+#include "tst_builderservice.moc"

@@ -1,0 +1,173 @@
+// MainWindow end to end (GL: it hosts CloudView): open a shared file through the menu's entry
+// and wait for the build, panels and status follow, the level model passes the model tester,
+// a malformed file shows a named error and the app stays usable, settings persist, closing
+// mid-build returns promptly.
+#include "app_test_support.hpp"
+#include "build_panel.hpp"
+#include "builder_service.hpp"
+#include "charts_panel.hpp"
+#include "cut_panel.hpp"
+#include "level_model.hpp"
+#include "main_window.hpp"
+
+#include <QAbstractItemModelTester>
+#include <QElapsedTimer>
+#include <QFile>
+#include <QImage>
+#include <QMessageBox>
+#include <QSettings>
+#include <QSignalSpy>
+#include <QStandardPaths>
+#include <QSurfaceFormat>
+#include <QTemporaryDir>
+#include <QtTest>
+
+using namespace omicron;
+
+namespace {
+constexpr int kBuildTimeoutMs = 120'000;
+}
+
+class TestMainWindowGL : public QObject {
+    Q_OBJECT
+private slots:
+    void initTestCase();
+    void openingASharedFileBuildsAndFillsThePanels();
+    void malformedFileShowsANamedErrorAndTheAppStaysUsable();
+    void unavailableHierarchyFileIsAnErrorNotACrash();
+    void closingMidBuildReturnsPromptly();
+};
+
+void TestMainWindowGL::initTestCase() {
+    // Keep the user's settings out of the tests (QSettings follows the test-mode paths).
+    QStandardPaths::setTestModeEnabled(true);
+    QCoreApplication::setOrganizationName(QStringLiteral("omicron-tests"));
+    QCoreApplication::setApplicationName(QStringLiteral("tst_mainwindowGL"));
+    QSettings().clear();
+}
+
+void TestMainWindowGL::openingASharedFileBuildsAndFillsThePanels() {
+    OMICRON_REQUIRE_SHARED_FILE(path, "bunny.ply");
+    QTemporaryDir dir;
+    {
+        MainWindow window;
+        window.resize(1400, 900);
+        window.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        QAbstractItemModelTester tester(window.cutPanel()->levelModel(),
+                                        QAbstractItemModelTester::FailureReportingMode::QtTest);
+        QSignalSpy finished(window.service(), &BuilderService::buildFinished);
+        window.openFile(path);
+        QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 1, kBuildTimeoutMs);
+        QTRY_VERIFY(!window.service()->busy());
+        const auto result = finished.first().at(0).value<PipelineResult>();
+        QVERIFY(result.stats.complete);
+        QVERIFY(window.windowTitle().contains(QStringLiteral("bunny.ply")));
+        // Panels show the finished build.
+        for (int bar = 0; bar < 4; ++bar) {
+            QCOMPARE(window.cutPanel()->barValue(bar), 1000);
+        }
+        LevelModel* levels = window.cutPanel()->levelModel();
+        QCOMPARE(levels->rowCount(), window.buildPanel()->pipelineOptions().build.maxLevel + 1);
+        QCOMPARE(levels->value(0, LevelModel::CutRoots), quint64(1));
+        QCOMPARE(levels->value(0, LevelModel::Nodes), quint64(1));
+        QCOMPARE(window.recentFiles().value(0), path);
+
+        // Rebuild from the panel: no re-read, a deeper table.
+        BuilderService* service = window.service();
+        PipelineOptions deeper = window.buildPanel()->pipelineOptions();
+        deeper.build.maxLevel = 9;
+        window.buildPanel()->setPipelineOptions(deeper);
+        window.buildPanel()->requestRebuild();
+        QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 2, kBuildTimeoutMs);
+        QTRY_VERIFY(!service->busy());
+        QCOMPARE(service->sourceReads(), 1u);
+        QCOMPARE(levels->rowCount(), 10);
+
+        // Screenshot of the view.
+        const QString shot = dir.filePath(QStringLiteral("shot.png"));
+        QVERIFY(window.saveScreenshot(shot));
+        QVERIFY(!QImage(shot).isNull());
+        window.close();
+    }
+    // Recent files and parameters persisted; a new window starts with them.
+    MainWindow again;
+    QCOMPARE(again.recentFiles().value(0), path);
+    QCOMPARE(again.buildPanel()->pipelineOptions().build.maxLevel, 9);
+}
+
+void TestMainWindowGL::malformedFileShowsANamedErrorAndTheAppStaysUsable() {
+    QTemporaryDir dir;
+    MainWindow window;
+    window.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&window));
+    QSignalSpy finished(window.service(), &BuilderService::buildFinished);
+    window.openDefaultScene(30'000);
+    QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 1, kBuildTimeoutMs);
+    QTRY_VERIFY(!window.service()->busy());
+    const auto kept = window.service()->hierarchy();
+
+    const QString bad = dir.filePath(QStringLiteral("broken.ply"));
+    QFile file(bad);
+    QVERIFY(file.open(QIODevice::WriteOnly));
+    file.write("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n");
+    file.close();
+    window.openFile(bad);
+    QTRY_VERIFY_WITH_TIMEOUT(window.errorDialog() != nullptr, kBuildTimeoutMs);
+    QMessageBox* box = window.errorDialog();
+    QVERIFY(box->isVisible());
+    QVERIFY2(box->text().contains(QStringLiteral("broken.ply")), qPrintable(box->text()));
+    QVERIFY2(box->informativeText().contains(bad), qPrintable(box->informativeText()));
+    box->close();
+    QTRY_VERIFY(window.errorDialog() == nullptr);
+    // The view and the service kept the previous hierarchy; the app goes on working.
+    QTRY_VERIFY(!window.service()->busy());
+    QCOMPARE(window.service()->hierarchy(), kept);
+    window.openDefaultScene(20'000);
+    QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 2, kBuildTimeoutMs);
+    QVERIFY(finished.last().at(0).value<PipelineResult>().stats.complete);
+}
+
+void TestMainWindowGL::unavailableHierarchyFileIsAnErrorNotACrash() {
+    QTemporaryDir dir;
+    MainWindow window;
+    window.show();
+    const QString omh = dir.filePath(QStringLiteral("scene.omh"));
+    window.saveHierarchy(omh);
+    QTRY_VERIFY(window.errorDialog() != nullptr);
+    QVERIFY(window.errorDialog()->informativeText().contains(omh));
+    window.errorDialog()->close();
+}
+
+void TestMainWindowGL::closingMidBuildReturnsPromptly() {
+    std::weak_ptr<const Hierarchy> hierarchy;
+    QElapsedTimer clock;
+    {
+        MainWindow window;
+        window.show();
+        QSignalSpy attached(window.service(), &BuilderService::hierarchyChanged);
+        window.openDefaultScene(3'000'000);
+        QTRY_VERIFY_WITH_TIMEOUT(attached.count() > 0, kBuildTimeoutMs);
+        hierarchy = window.service()->hierarchy();
+        QVERIFY(window.service()->busy());
+        clock.start();
+        window.close();
+    }
+    QVERIFY2(clock.elapsed() < 10'000, qPrintable(QString::number(clock.elapsed())));
+    // The window, its view and the service are gone, and with them the builder and its
+    // threads: nothing holds the hierarchy any more.
+    QVERIFY(hierarchy.expired());
+}
+
+int main(int argc, char* argv[]) {
+    QSurfaceFormat format;
+    format.setVersion(4, 5);
+    format.setProfile(QSurfaceFormat::CoreProfile);
+    format.setDepthBufferSize(24);
+    QSurfaceFormat::setDefaultFormat(format);
+    QApplication app(argc, argv);
+    TestMainWindowGL test;
+    return QTest::qExec(&test, argc, argv);
+}
+
+#include "tst_mainwindowGL.moc"
