@@ -6,6 +6,7 @@
 #include "build_panel.hpp"
 #include "builder_service.hpp"
 #include "charts_panel.hpp"
+#include "cloud_view.hpp"
 #include "cut_panel.hpp"
 #include "level_model.hpp"
 #include "main_window.hpp"
@@ -16,6 +17,7 @@
 #include <QImage>
 #include <QMessageBox>
 #include <QSettings>
+#include <QFileInfo>
 #include <QSignalSpy>
 #include <QStandardPaths>
 #include <QSurfaceFormat>
@@ -34,7 +36,7 @@ private slots:
     void initTestCase();
     void openingASharedFileBuildsAndFillsThePanels();
     void malformedFileShowsANamedErrorAndTheAppStaysUsable();
-    void unavailableHierarchyFileIsAnErrorNotACrash();
+    void savedHierarchyOpensThroughTheFileMenu();
     void closingMidBuildReturnsPromptly();
 };
 
@@ -128,15 +130,38 @@ void TestMainWindowGL::malformedFileShowsANamedErrorAndTheAppStaysUsable() {
     QVERIFY(finished.last().at(0).value<PipelineResult>().stats.complete);
 }
 
-void TestMainWindowGL::unavailableHierarchyFileIsAnErrorNotACrash() {
+// File > Save Hierarchy As, then File > Open of the .omh (pipeline 3); saving before any
+// hierarchy exists is an error dialog, not a crash.
+void TestMainWindowGL::savedHierarchyOpensThroughTheFileMenu() {
     QTemporaryDir dir;
     MainWindow window;
     window.show();
     const QString omh = dir.filePath(QStringLiteral("scene.omh"));
     window.saveHierarchy(omh);
     QTRY_VERIFY(window.errorDialog() != nullptr);
-    QVERIFY(window.errorDialog()->informativeText().contains(omh));
     window.errorDialog()->close();
+    QTRY_VERIFY(window.errorDialog() == nullptr);
+    QVERIFY(!QFileInfo::exists(omh));
+
+    QSignalSpy finished(window.service(), &BuilderService::buildFinished);
+    window.openDefaultScene(20'000);
+    QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 1, kBuildTimeoutMs);
+    QTRY_VERIFY(!window.service()->busy());
+    const auto built = finished.first().at(0).value<PipelineResult>();
+    window.saveHierarchy(omh);
+    QTRY_VERIFY_WITH_TIMEOUT(QFileInfo::exists(omh) && !window.service()->busy(), kBuildTimeoutMs);
+    QVERIFY(window.errorDialog() == nullptr);
+
+    window.openFile(omh);
+    QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 2, kBuildTimeoutMs);
+    const auto loaded = finished.last().at(0).value<PipelineResult>();
+    QCOMPARE(loaded.source.kind, PipelineKind::HierarchyFile);
+    QCOMPARE(loaded.stats.levels.size(), built.stats.levels.size());
+    for (std::size_t level = 0; level < built.stats.levels.size(); ++level) {
+        QCOMPARE(loaded.stats.levels[level].nodes, built.stats.levels[level].nodes);
+        QCOMPARE(loaded.stats.levels[level].points, built.stats.levels[level].points);
+    }
+    QTRY_VERIFY(window.cloudView()->hierarchy() == window.service()->hierarchy());
 }
 
 void TestMainWindowGL::closingMidBuildReturnsPromptly() {
