@@ -5,9 +5,7 @@
 // Needs a display (xvfb-run on headless machines).
 #include "bench_timing.hpp"
 #include "cloud_view.hpp"
-#include "hierarchy_builder.hpp"
-#include "morton_sorter.hpp"
-#include "point_reader.hpp"
+#include "build_pipeline.hpp"
 
 #include <QApplication>
 #include <QImage>
@@ -24,14 +22,9 @@ using namespace omicron;
 namespace {
 
 std::shared_ptr<const Hierarchy> buildHierarchy(const std::string& path) {
-    auto reader = openPointCloud(path);
-    IncrementalMortonSorter sorter(reader->info(), SortOptions{});
-    HierarchyBuilder builder(sorter.cloud(), BuildOptions{});
-    reader->read([&](const PointBatch& batch) { sorter.add(batch); });
-    sorter.sortAndEmit(builder.consumer());
-    builder.finish();
-    builder.wait();
-    return builder.sharedHierarchy();
+    BuildPipeline pipeline;
+    pipeline.run(path, {BuildOptions{}, kDefaultSortChunks});
+    return pipeline.hierarchy();
 }
 
 double percentile(std::vector<double> values, double p) {

@@ -2,14 +2,11 @@
 // the finished hierarchy through the same CloudView the application shows, without a visible
 // window. Needs a display for the OpenGL context (under CI: xvfb-run).
 #include "atomic_file_writer.hpp"
+#include "build_pipeline.hpp"
 #include "cli_args.hpp"
 #include "cloud_view.hpp"
 #include "commands.hpp"
-#include "hierarchy_builder.hpp"
 #include "input_error.hpp"
-#include "omh_reader.hpp"
-#include "oms_reader.hpp"
-#include "point_reader.hpp"
 
 #include <QApplication>
 #include <QImage>
@@ -49,30 +46,12 @@ QSize parseSize(const std::string& text) {
     return QSize(static_cast<int>(width), static_cast<int>(height));
 }
 
+// Pipelines 1, 2 or 3 by the file's kind: the same driver as `build` and the application.
 std::shared_ptr<const Hierarchy> loadOrBuildHierarchy(const std::string& path,
                                                       const BuildOptions& options) {
-    if (isOmhFile(path)) { // pipeline 3: the saved hierarchy, loaded top-down
-        OmhReader reader(path);
-        auto hierarchy = reader.hierarchy();
-        reader.load();
-        return hierarchy;
-    }
-    if (isOmsFile(path)) {
-        OmsReader reader(path);
-        HierarchyBuilder builder(reader.cloud(), options);
-        reader.read(builder.consumer());
-        builder.finish();
-        builder.wait();
-        return builder.sharedHierarchy();
-    }
-    auto reader = openPointCloud(path);
-    IncrementalMortonSorter sorter(reader->info(), SortOptions{});
-    HierarchyBuilder builder(sorter.cloud(), options);
-    reader->read([&](const PointBatch& batch) { sorter.add(batch); });
-    sorter.sortAndEmit(builder.consumer());
-    builder.finish();
-    builder.wait();
-    return builder.sharedHierarchy();
+    BuildPipeline pipeline;
+    pipeline.run(path, {options, kDefaultSortChunks});
+    return pipeline.hierarchy();
 }
 
 int runRender(const std::vector<std::string>& args) {

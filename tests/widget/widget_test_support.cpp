@@ -1,8 +1,6 @@
 #include "widget_test_support.hpp"
 
-#include "hierarchy_builder.hpp"
-#include "morton_sorter.hpp"
-#include "point_reader.hpp"
+#include "build_pipeline.hpp"
 
 #include <QFileInfo>
 #include <cstdlib>
@@ -15,14 +13,9 @@ QString sharedDataFile(const char* name) {
 }
 
 std::shared_ptr<const Hierarchy> buildHierarchy(const QString& path, const BuildOptions& options) {
-    auto reader = openPointCloud(path.toStdString());
-    IncrementalMortonSorter sorter(reader->info(), SortOptions{});
-    HierarchyBuilder builder(sorter.cloud(), options);
-    reader->read([&](const PointBatch& batch) { sorter.add(batch); });
-    sorter.sortAndEmit(builder.consumer());
-    builder.finish();
-    builder.wait();
-    return builder.sharedHierarchy();
+    BuildPipeline pipeline;
+    pipeline.run(path.toStdString(), {options, kDefaultSortChunks});
+    return pipeline.hierarchy();
 }
 
 double coverage(const QImage& image, const QColor& background) {
