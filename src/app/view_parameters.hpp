@@ -8,8 +8,9 @@
 namespace omicron {
 
 struct ViewParameters {
-    double projectionThresholdPx = 100.0; // front: branch above, prune below
-    std::size_t pointBudget = 3'000'000;  // most points drawn per frame
+    // The same defaults as the viewer's RenderSettings (see render_settings.hpp for why).
+    double projectionThresholdPx = 16.0; // front: branch above, prune below
+    std::size_t pointBudget = 1'000'000; // most points drawn per frame
     bool splats = false;                  // surface splats instead of GL points
     friend bool operator==(const ViewParameters&, const ViewParameters&) = default;
 };
