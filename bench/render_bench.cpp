@@ -99,14 +99,12 @@ int main(int argc, char** argv) {
     view.setHierarchy(hierarchy);
     (void)view.renderImage(QSize(64, 64)); // bounds and auto-fit
     const ViewCamera start = view.camera();
-    const char* renderer = "unknown";
-    const std::string glRenderer = view.glRendererName().toStdString();
-    renderer = glRenderer.c_str();
+    const std::string renderer = view.glRendererName().toStdString();
 
     const PathResult empty = runPath(view, start, frames, 1);
     std::printf("bench=render phase=baseline_no_points renderer=\"%s\" size=%dx%d frames=%d "
                 "frame_ms_median=%.2f frame_ms_p95=%.2f front_ms_median=%.3f\n",
-                renderer, width, height, frames, empty.frameMsMedian, empty.frameMsP95,
+                renderer.c_str(), width, height, frames, empty.frameMsMedian, empty.frameMsP95,
                 empty.frontMsMedian);
     for (std::size_t budget : {std::size_t{250'000}, std::size_t{1'000'000}, std::size_t{0}}) {
         const PathResult result = runPath(view, start, frames, budget);

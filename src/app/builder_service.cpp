@@ -81,33 +81,28 @@ bool BuilderService::rebuild(const BuildOptions& options) {
 }
 
 bool BuilderService::exportSortedStream(const QString& path) {
-    const auto cloud = m_pipeline->sortedCloud();
-    if (!cloud || !cloud->complete()) {
-        emit failed(path, tr("Nothing to export: wait until the cloud is completely sorted."));
-        return false;
-    }
-    const std::string file = path.toStdString();
-    submit({QFileInfo(path).fileName(), false,
-            [file, cloud, path](BuildPipeline&) {
-                writeOms(file, *cloud, cloud->sortedEnd());
-                return JobOutcome{{}, tr("Wrote the sorted stream %1").arg(path)};
-            },
-            path});
-    return true;
+    return submitCloudExport(path, [](const std::string& file, const SortedCloud& cloud) {
+        writeOms(file, cloud, cloud.sortedEnd());
+        return tr("Wrote the sorted stream %1").arg(QString::fromStdString(file));
+    });
 }
 
 bool BuilderService::exportPoints(const QString& path) {
+    return submitCloudExport(path, [](const std::string& file, const SortedCloud& cloud) {
+        exportCloudPoints(file, cloud);
+        return tr("Exported %1 points to %2").arg(cloud.sortedEnd()).arg(QString::fromStdString(file));
+    });
+}
+
+bool BuilderService::submitCloudExport(const QString& path, CloudWriter write) {
     const auto cloud = m_pipeline->sortedCloud();
     if (!cloud || !cloud->complete()) {
         emit failed(path, tr("Nothing to export: wait until the cloud is completely sorted."));
         return false;
     }
-    const std::string file = path.toStdString();
     submit({QFileInfo(path).fileName(), false,
-            [file, cloud, path](BuildPipeline&) {
-                exportCloudPoints(file, *cloud);
-                return JobOutcome{{},
-                                  tr("Exported %1 points to %2").arg(cloud->sortedEnd()).arg(path)};
+            [file = path.toStdString(), cloud, write](BuildPipeline&) {
+                return JobOutcome{{}, write(file, *cloud)};
             },
             path});
     return true;

@@ -97,6 +97,10 @@ private:
         bool opensSource = false; // reads a file or the scene (replaces the kept cloud)
     };
 
+    // Writes the kept sorted cloud to a file on the worker; returns the status-bar message.
+    using CloudWriter = std::function<QString(const std::string& file, const SortedCloud& cloud)>;
+    // Refuses (failed signal) until the cloud is completely sorted.
+    bool submitCloudExport(const QString& path, CloudWriter write);
     void submit(Job job);
     void startJob(Job job);
     void joinWorker();

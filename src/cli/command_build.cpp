@@ -4,6 +4,7 @@
 #include "commands.hpp"
 #include "build_pipeline.hpp"
 #include "json_writer.hpp"
+#include "levels_json.hpp"
 #include "omh_writer.hpp"
 
 #include <chrono>
@@ -77,16 +78,7 @@ void printJson(const PipelineResult& run, const BuildOptions& options, const Sav
     json.key("collapsed_leaves").value(s.collapsedLeaves);
     json.key("placeholders_created").value(s.placeholdersCreated);
     json.key("placeholders_substituted").value(s.placeholdersSubstituted);
-    json.key("levels").beginArray();
-    for (std::size_t level = 0; level < s.levels.size(); ++level) {
-        json.beginObject();
-        json.key("level").value(static_cast<std::uint64_t>(level));
-        json.key("nodes").value(s.levels[level].nodes);
-        json.key("leaves").value(s.levels[level].leaves);
-        json.key("points").value(s.levels[level].points);
-        json.endObject();
-    }
-    json.endArray();
+    writeLevelsJson(json, s.levels);
     json.key("nodes").value(s.totalNodes());
     json.key("creation_s").value(s.creationSeconds);
     json.key("read_s").value(run.readSeconds);

@@ -9,6 +9,7 @@
 #include "input_error.hpp"
 
 #include <QApplication>
+#include <QBuffer>
 #include <QImage>
 #include <cstdio>
 #include <cstdlib>
@@ -140,12 +141,15 @@ int runRender(const std::vector<std::string>& args) {
     if (image.isNull()) {
         throw OutputError(outPath + ": no OpenGL 3.3 context: " + view.glErrorString().toStdString());
     }
-    const std::string temporary = outPath + ".partial.png";
-    if (!image.save(QString::fromStdString(temporary), "PNG") ||
-        std::rename(temporary.c_str(), outPath.c_str()) != 0) {
-        std::remove(temporary.c_str());
-        throw OutputError(outPath + ": cannot write the image");
+    QByteArray png;
+    QBuffer buffer(&png);
+    buffer.open(QIODevice::WriteOnly);
+    if (!image.save(&buffer, "PNG")) {
+        throw OutputError(outPath + ": cannot encode the image as PNG");
     }
+    AtomicFileWriter writer(outPath); // temporary file + rename: no partial PNG is ever left
+    writer.write(png.constData(), static_cast<std::size_t>(png.size()));
+    writer.commit();
     const FrameStats stats = view.lastFrameStats();
     std::printf("rendered %zu of %zu points (%zu nodes) at %dx%d into %s\n", stats.pointsDrawn,
                 stats.pointsTotal, stats.nodesDrawn, size.width(), size.height(), outPath.c_str());

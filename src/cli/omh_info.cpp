@@ -1,6 +1,7 @@
 #include "omh_info.hpp"
 
 #include "json_writer.hpp"
+#include "levels_json.hpp"
 #include "omh_reader.hpp"
 
 #include <cstdio>
@@ -55,16 +56,7 @@ void printJson(const omh::Header& h, bool verified) {
     writeVector(json, h.cube.origin);
     json.key("edge").value(h.cube.edge);
     json.endObject();
-    json.key("levels").beginArray();
-    for (std::size_t level = 0; level < h.levels.size(); ++level) {
-        json.beginObject();
-        json.key("level").value(static_cast<std::uint64_t>(level));
-        json.key("nodes").value(h.levels[level].nodes);
-        json.key("leaves").value(h.levels[level].leaves);
-        json.key("points").value(h.levels[level].points);
-        json.endObject();
-    }
-    json.endArray();
+    writeLevelsJson(json, h.levels);
     json.key("nodes").value(h.totalNodes);
     json.key("points_stored").value(h.totalPoints);
     json.key("verified").value(verified);

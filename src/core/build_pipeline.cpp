@@ -83,19 +83,41 @@ struct PipelineState {
     std::shared_ptr<const SortedCloud> cloud;
     std::shared_ptr<HierarchyBuilder> builder;
     std::shared_ptr<const Hierarchy> loaded;
+    BuildStatistics loadedStatistics;
+    BuildOptions loadedOptions;
 };
 
 PipelineResult BuildPipeline::run(const std::string& path, const PipelineOptions& options) {
     validate(options.build); // std::invalid_argument before anything is touched
-    if (isOmhFile(path)) {
-        return runHierarchyFile(path);
+    PipelineState saved;
+    {
+        std::lock_guard lock(m_mutex);
+        saved = {m_source, m_cloud, m_builder, m_loaded, m_loadedStatistics, m_loadedOptions};
     }
-    return isOmsFile(path) ? runSortedStream(path, options) : runCloud(path, options);
+    try {
+        if (isOmhFile(path)) {
+            return runHierarchyFile(path);
+        }
+        return isOmsFile(path) ? runSortedStream(path, options) : runCloud(path, options);
+    } catch (...) {
+        // A bad file changes nothing: the previous source, cloud and hierarchy stay shown.
+        setPhase(BuildPhase::Failed);
+        std::lock_guard lock(m_mutex);
+        m_sorter.reset();
+        m_source = std::move(saved.source);
+        m_cloud = std::move(saved.cloud);
+        m_builder = std::move(saved.builder);
+        m_loaded = std::move(saved.loaded);
+        m_loadedStatistics = std::move(saved.loadedStatistics);
+        m_loadedOptions = saved.loadedOptions;
+        m_pointsTotal.store(m_source ? m_source->pointCount : 0);
+        throw;
+    }
 }
 
 PipelineResult BuildPipeline::runHierarchyFile(const std::string& path) {
     beginRun(BuildPhase::Opening);
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     OmhReader reader(path); // header, level table and footer checked: throws before any change
     const omh::Header& header = reader.header();
     PipelineSource source;
@@ -139,8 +161,7 @@ PipelineResult BuildPipeline::runHierarchyFile(const std::string& path) {
     PipelineResult result;
     result.source = source;
     result.pipeline = toString(PipelineKind::HierarchyFile);
-    result.readSeconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.readSeconds = secondsSince(start);
     result.cancelled = cancelled();
     statistics.complete = !result.cancelled;
     statistics.creationSeconds = result.readSeconds;
@@ -191,121 +212,88 @@ PipelineResult BuildPipeline::finishBuild(HierarchyBuilder& builder, PipelineRes
 
 PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOptions& options) {
     beginRun(BuildPhase::Opening);
-    PipelineState saved;
+    auto reader = openPointCloud(path);
+    const CloudInfo& info = reader->info();
+    SortOptions sortOptions;
+    sortOptions.chunks = options.sortChunks;
+    sortOptions.cancel = &m_cancel;
+    auto sorter = std::make_shared<IncrementalMortonSorter>(info, sortOptions);
+    PipelineResult result;
+    result.pipeline = toString(PipelineKind::UnsortedCloud);
+    result.source = {path,
+                     describeCloud(info),
+                     PipelineKind::UnsortedCloud,
+                     info.pointCount,
+                     info.attributes,
+                     info.cube,
+                     info.sourceOffset};
+    setSource(result.source, sorter->cloud());
     {
         std::lock_guard lock(m_mutex);
-        saved = {m_source, m_cloud, m_builder, m_loaded};
+        m_sorter = sorter;
     }
-    try {
-        auto reader = openPointCloud(path);
-        const CloudInfo& info = reader->info();
-        SortOptions sortOptions;
-        sortOptions.chunks = options.sortChunks;
-        sortOptions.cancel = &m_cancel;
-        auto sorter = std::make_shared<IncrementalMortonSorter>(info, sortOptions);
-        PipelineResult result;
-        result.pipeline = toString(PipelineKind::UnsortedCloud);
-        result.source = {path,
-                         describeCloud(info),
-                         PipelineKind::UnsortedCloud,
-                         info.pointCount,
-                         info.attributes,
-                         info.cube,
-                         info.sourceOffset};
-        setSource(result.source, sorter->cloud());
-        {
-            std::lock_guard lock(m_mutex);
-            m_sorter = sorter;
-        }
-        const auto builder = startBuilder(options.build);
-        m_sourceReads.fetch_add(1);
-        setPhase(BuildPhase::Reading);
-        ReadOptions readOptions;
-        readOptions.batchPoints = sortOptions.batchPoints;
-        readOptions.cancel = &m_cancel;
-        const auto readStart = Clock::now();
-        const ReadSummary read = reader->read(
-            [&](const PointBatch& batch) {
-                sorter->add(batch);
-                m_pointsRead.fetch_add(batch.size(), std::memory_order_relaxed);
-            },
-            readOptions);
-        result.readSeconds = secondsSince(readStart);
-        result.skippedNonFinite = read.skippedNonFinite;
-        result.cancelled = read.cancelled;
-        if (!result.cancelled) {
-            setPhase(BuildPhase::Sorting);
-            const auto sortStart = Clock::now();
-            sorter->sortAndEmit(builder->consumer());
-            result.sortSeconds = secondsSince(sortStart);
-        }
-        {
-            // The sorter's unsorted copy of the input is as large as the cloud: let it go.
-            std::lock_guard lock(m_mutex);
-            m_sorter.reset();
-        }
-        return finishBuild(*builder, std::move(result));
-    } catch (...) {
-        setPhase(BuildPhase::Failed);
+    const auto builder = startBuilder(options.build);
+    m_sourceReads.fetch_add(1);
+    setPhase(BuildPhase::Reading);
+    ReadOptions readOptions;
+    readOptions.batchPoints = sortOptions.batchPoints;
+    readOptions.cancel = &m_cancel;
+    const auto readStart = Clock::now();
+    const ReadSummary read = reader->read(
+        [&](const PointBatch& batch) {
+            sorter->add(batch);
+            m_pointsRead.fetch_add(batch.size(), std::memory_order_relaxed);
+        },
+        readOptions);
+    result.readSeconds = secondsSince(readStart);
+    result.skippedNonFinite = read.skippedNonFinite;
+    result.cancelled = read.cancelled;
+    if (!result.cancelled) {
+        setPhase(BuildPhase::Sorting);
+        const auto sortStart = Clock::now();
+        sorter->sortAndEmit(builder->consumer());
+        result.sortSeconds = secondsSince(sortStart);
+    }
+    {
+        // The sorter's unsorted copy of the input is as large as the cloud: let it go.
         std::lock_guard lock(m_mutex);
         m_sorter.reset();
-        m_source = std::move(saved.source);
-        m_cloud = std::move(saved.cloud);
-        m_builder = std::move(saved.builder);
-        m_loaded = std::move(saved.loaded);
-        m_pointsTotal.store(m_source ? m_source->pointCount : 0);
-        throw;
     }
+    return finishBuild(*builder, std::move(result));
 }
 
 PipelineResult BuildPipeline::runSortedStream(const std::string& path,
                                               const PipelineOptions& options) {
     beginRun(BuildPhase::Opening);
-    PipelineState saved;
-    {
-        std::lock_guard lock(m_mutex);
-        saved = {m_source, m_cloud, m_builder, m_loaded};
-    }
-    try {
-        OmsReader reader(path);
-        const OmsInfo& info = reader.info();
-        PipelineResult result;
-        result.pipeline = toString(PipelineKind::SortedStream);
-        result.source = {path,
-                         "omicron sorted stream v" + std::to_string(info.version) + ", " +
-                             std::to_string(info.pointCount) + " points",
-                         PipelineKind::SortedStream,
-                         info.pointCount,
-                         info.attributes,
-                         info.cube,
-                         info.sourceOffset};
-        setSource(result.source, reader.cloud());
-        const auto builder = startBuilder(options.build);
-        m_sourceReads.fetch_add(1);
-        setPhase(BuildPhase::Sorting);
-        ReadOptions readOptions;
-        readOptions.cancel = &m_cancel;
-        const auto readStart = Clock::now();
-        const SortedRangeConsumer forward = builder->consumer();
-        const ReadSummary read = reader.read(
-            [&](const SortedCloud& cloud, std::size_t begin, std::size_t end) {
-                m_pointsRead.store(end, std::memory_order_relaxed);
-                forward(cloud, begin, end);
-            },
-            readOptions);
-        result.readSeconds = secondsSince(readStart);
-        result.cancelled = read.cancelled;
-        return finishBuild(*builder, std::move(result));
-    } catch (...) {
-        setPhase(BuildPhase::Failed);
-        std::lock_guard lock(m_mutex);
-        m_source = std::move(saved.source);
-        m_cloud = std::move(saved.cloud);
-        m_builder = std::move(saved.builder);
-        m_loaded = std::move(saved.loaded);
-        m_pointsTotal.store(m_source ? m_source->pointCount : 0);
-        throw;
-    }
+    OmsReader reader(path);
+    const OmsInfo& info = reader.info();
+    PipelineResult result;
+    result.pipeline = toString(PipelineKind::SortedStream);
+    result.source = {path,
+                     "omicron sorted stream v" + std::to_string(info.version) + ", " +
+                         std::to_string(info.pointCount) + " points",
+                     PipelineKind::SortedStream,
+                     info.pointCount,
+                     info.attributes,
+                     info.cube,
+                     info.sourceOffset};
+    setSource(result.source, reader.cloud());
+    const auto builder = startBuilder(options.build);
+    m_sourceReads.fetch_add(1);
+    setPhase(BuildPhase::Sorting);
+    ReadOptions readOptions;
+    readOptions.cancel = &m_cancel;
+    const auto readStart = Clock::now();
+    const SortedRangeConsumer forward = builder->consumer();
+    const ReadSummary read = reader.read(
+        [&](const SortedCloud& cloud, std::size_t begin, std::size_t end) {
+            m_pointsRead.store(end, std::memory_order_relaxed);
+            forward(cloud, begin, end);
+        },
+        readOptions);
+    result.readSeconds = secondsSince(readStart);
+    result.cancelled = read.cancelled;
+    return finishBuild(*builder, std::move(result));
 }
 
 PipelineResult BuildPipeline::runGeneratedScene(std::uint64_t points, std::uint64_t seed,

@@ -163,26 +163,28 @@ void CloudNode::collectDrawList(RenderContext& context) {
         // Input arrives in Morton order, so where a node's points start in the sorted cloud
         // is when the sweep reached it: the build-age colour shows the oblique sweep.
         const float age = static_cast<float>(node.coveredBegin / capacity);
-        m_drawList.push_back({NodeBufferCache::key(level, entry.index), level, entry.index, age});
+        const NodeBufferCache::Key key = NodeBufferCache::key(level, entry.index);
+        m_drawList.push_back({key, level, entry.index, age, m_cache.use(key, m_frame)});
     }
 
     // Upload what is missing, coarse nodes first (they cover the most screen per byte),
     // within the per-frame budget.
-    std::vector<const DrawItem*> missing;
-    for (const DrawItem& item : m_drawList) {
-        if (m_cache.use(item.key, m_frame) == nullptr) {
+    std::vector<DrawItem*> missing;
+    for (DrawItem& item : m_drawList) {
+        if (item.buffer == nullptr) {
             missing.push_back(&item);
         }
     }
     std::stable_sort(missing.begin(), missing.end(),
                      [](const DrawItem* a, const DrawItem* b) { return a->level < b->level; });
     std::size_t uploadedBytes = 0;
-    for (const DrawItem* item : missing) {
+    for (DrawItem* item : missing) {
         if (!context.settle && uploadedBytes >= context.settings->uploadBudgetBytes) {
             break;
         }
         packNodeVertices(*m_hierarchy, m_hierarchy->node(item->level, item->index), m_scratch);
-        uploadedBytes += m_cache.upload(*context.gl, item->key, m_scratch, m_frame).bytes;
+        item->buffer = &m_cache.upload(*context.gl, item->key, m_scratch, m_frame);
+        uploadedBytes += item->buffer->bytes;
         ++context.stats->uploads;
     }
 }
@@ -255,15 +257,14 @@ void CloudNode::drawItems(RenderContext& context, QOpenGLShaderProgram& program)
     const int levelLocation = program.uniformLocation("u_levelColor");
     const int ageLocation = program.uniformLocation("u_buildAge");
     for (const DrawItem& item : m_drawList) {
-        const NodeBufferCache::Buffer* buffer = m_cache.use(item.key, m_frame);
-        if (buffer == nullptr) {
+        if (item.buffer == nullptr) {
             continue; // not uploaded yet (per-frame budget)
         }
         const glm::vec3 color = levelColor(item.level);
         program.setUniformValue(levelLocation, QVector3D(color.x, color.y, color.z));
         program.setUniformValue(ageLocation, item.buildAge);
-        bindVertexLayout(gl, buffer->vbo);
-        gl.glDrawArrays(GL_POINTS, 0, buffer->pointCount);
+        bindVertexLayout(gl, item.buffer->vbo);
+        gl.glDrawArrays(GL_POINTS, 0, item.buffer->pointCount);
     }
 }
 
@@ -374,8 +375,8 @@ void CloudNode::render(RenderContext& context) {
         context.stats->pointsDrawn = static_cast<std::size_t>(m_previewCount);
     } else {
         for (const DrawItem& item : m_drawList) {
-            if (const auto* buffer = m_cache.use(item.key, m_frame)) {
-                context.stats->pointsDrawn += static_cast<std::size_t>(buffer->pointCount);
+            if (item.buffer != nullptr) {
+                context.stats->pointsDrawn += static_cast<std::size_t>(item.buffer->pointCount);
                 ++context.stats->nodesDrawn;
             }
         }

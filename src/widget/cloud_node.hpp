@@ -50,6 +50,9 @@ private:
         int level;
         std::uint32_t index;
         float buildAge;
+        // Resident buffer, nullptr until uploaded (cache entries do not move before eviction,
+        // which runs after drawing).
+        const NodeBufferCache::Buffer* buffer;
     };
 
     void evaluateFront(RenderContext& context);

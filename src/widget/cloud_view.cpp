@@ -257,8 +257,6 @@ void CloudView::initializeGL() {
     d->frameTimer.start();
 }
 
-void CloudView::resizeGL(int, int) {}
-
 FrameStats CloudView::renderFrame(unsigned framebuffer, int widthPx, int heightPx, bool settle) {
     QElapsedTimer timer;
     timer.start();
