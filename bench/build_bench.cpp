@@ -2,9 +2,11 @@
 //
 // usage: build_bench FILE [--depth D]   (e.g. ../shared/data/autzen_south.ply, depth 7)
 // (a) build from an in-memory sorted stream vs parsing the same file vs one memcpy of the
-//     points; (b) worklist size 8..128 -> creation time, nodes, resident bytes; (c) leaf
-//     collapse off/lossless/paper x ratio 0.2/0.25 -> resident bytes (and vs the file size),
-//     creation time; (d) 1 vs 2 threads. Each figure is the best of 3 runs.
+//     points, and what estimating the splat attributes of every node costs on top (a build
+//     leaves that to the nodes a renderer draws, or to a save); (b) worklist size 8..128 ->
+//     creation time, nodes, resident bytes; (c) leaf collapse off/lossless/paper x ratio 0.2/0.25
+//     -> resident bytes (and vs the file size), creation time; (d) 1 vs 2 threads. Each figure is
+//     the best of 3 runs.
 #include "bench_timing.hpp"
 #include "hierarchy_builder.hpp"
 #include "morton_sorter.hpp"
@@ -16,6 +18,8 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 #include <vector>
 
 namespace {
@@ -89,6 +93,34 @@ int main(int argc, char** argv) {
                     build.seconds / parseS, points / build.seconds / 1e6,
                     static_cast<unsigned long long>(build.stats.totalNodes()));
         std::fflush(stdout);
+        {
+            // Splats of every node, in parallel: what a .omh save or drawing everything pays.
+            omicron::HierarchyBuilder builder(cloud, base);
+            builder.onSortedRange(*cloud, 0, cloud->sortedEnd());
+            builder.finish();
+            builder.wait();
+            const omicron::Hierarchy& hierarchy = builder.hierarchy();
+            std::vector<const omicron::OctreeNode*> nodes;
+            std::uint64_t heldPoints = 0;
+            for (int level = 0; level <= hierarchy.maxLevel(); ++level) {
+                for (std::size_t i = 0; i < hierarchy.nodeCount(level); ++i) {
+                    nodes.push_back(&hierarchy.node(level, i));
+                    heldPoints += nodes.back()->pointCount;
+                }
+            }
+            tbb::enumerable_thread_specific<omicron::SplatScratch> scratch;
+            tbb::enumerable_thread_specific<omicron::NodeSplats> splats;
+            const double splatS = bestSeconds(3, [&] {
+                tbb::parallel_for(std::size_t{0}, nodes.size(), [&](std::size_t i) {
+                    hierarchy.nodeSplats(*nodes[i], splats.local(), scratch.local());
+                });
+            });
+            std::printf("bench=splat_estimate nodes=%zu held_points=%llu ms=%.1f "
+                        "mpoints_per_s=%.1f vs_parse=%.2f\n",
+                        nodes.size(), static_cast<unsigned long long>(heldPoints), splatS * 1e3,
+                        heldPoints / splatS / 1e6, splatS / parseS);
+            std::fflush(stdout);
+        }
 
         // (b) worklist sizes.
         for (std::size_t worklist : {8, 16, 32, 64, 128}) {

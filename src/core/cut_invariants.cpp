@@ -218,6 +218,10 @@ private:
         if (node.isLeaf() != (node.childCount == 0)) {
             return fail(where() + ": the leaf flag disagrees with its child count");
         }
+        if (node.splatScale != 1.0f) {
+            return fail(where() + ": splat scale " + std::to_string(node.splatScale) +
+                        "; a built node's splats are estimated from its own points (scale 1)");
+        }
         if (node.isLeaf()) {
             return checkLeaf(level, node, where);
         }
@@ -259,10 +263,6 @@ private:
                         std::to_string(sampleSize(childPoints, m_context.ratio)) + " of " +
                         std::to_string(childPoints) + " was expected");
         }
-        if (node.splatScale != parentSplatScale(children, node.pointCount)) {
-            return fail(where() + ": splat scale " + std::to_string(node.splatScale) +
-                        " does not match its sample");
-        }
         // Samples ascend and are drawn from the children's held points (both lists ascend).
         std::size_t child = 0;
         std::uint32_t held = 0;
@@ -294,8 +294,7 @@ private:
             if (level != m_maxLevel) {
                 return fail(where() + " is a leaf above maxLevel without being collapsed");
             }
-            if (!node.holdsRange() || node.pointCount != node.coveredCount ||
-                node.splatScale != 1.0f) {
+            if (!node.holdsRange() || node.pointCount != node.coveredCount) {
                 return fail(where() + ": a leaf must hold all the points it covers");
             }
             return true;

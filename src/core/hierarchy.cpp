@@ -1,13 +1,17 @@
 #include "hierarchy.hpp"
 
+#include "leaf_runs.hpp"
+
 #include <algorithm>
 #include <cassert>
 
 namespace omicron {
 
-Hierarchy::Hierarchy(std::shared_ptr<const SortedCloud> cloud, int maxLevel)
+Hierarchy::Hierarchy(std::shared_ptr<const SortedCloud> cloud, int maxLevel,
+                     SplatSource splatSource)
     : m_cloud(std::move(cloud)), m_maxLevel(maxLevel), m_insertions(m_cloud->capacity()),
-      m_splats(*m_cloud) {
+      m_storedSplats(splatSource == SplatSource::Stored ? std::make_unique<StoredSplats>(*m_cloud)
+                                                        : nullptr) {
     assert(maxLevel >= 0 && maxLevel <= morton::kMaxLevel);
     m_levels.reserve(static_cast<std::size_t>(maxLevel) + 1);
     for (int level = 0; level <= maxLevel; ++level) {
@@ -38,6 +42,40 @@ std::optional<std::size_t> Hierarchy::findNode(morton::Code code, std::size_t co
         return low;
     }
     return std::nullopt;
+}
+
+void Hierarchy::nodeSplats(const OctreeNode& node, NodeSplats& out, SplatScratch& scratch) const {
+    if (!m_storedSplats) {
+        // Finding the region costs two searches of the cloud: only for the nodes that use it.
+        const SparseSplatRegion region = node.pointCount < kMinPointsPerSplatEstimate
+                                             ? sparseSplatRegion(node)
+                                             : SparseSplatRegion{};
+        estimateNodeSplats(*m_cloud, node, region, estimatesNormals(), out, scratch);
+        return;
+    }
+    out.radii.resize(node.pointCount);
+    out.normals.resize(m_storedSplats->estimatesNormals() ? node.pointCount : 0);
+    for (std::uint32_t i = 0; i < node.pointCount; ++i) {
+        out.radii[i] = m_storedSplats->encodedRadius(node.heldPoint(i));
+    }
+    for (std::uint32_t i = 0; i < out.normals.size(); ++i) {
+        out.normals[i] = m_storedSplats->encodedNormal(node.heldPoint(i));
+    }
+}
+
+SparseSplatRegion Hierarchy::sparseSplatRegion(const OctreeNode& node) const {
+    if (!node.holdsRange()) {
+        return {node.coveredBegin, node.coveredCount, node.pointCount};
+    }
+    if (node.level() != m_maxLevel || m_maxLevel == 0 || node.pointCount == 0) {
+        return {node.coveredBegin, node.coveredCount, node.coveredCount};
+    }
+    const std::span<const morton::Code> codes = m_cloud->codes();
+    const int groupShift = 3 * (morton::kMaxLevel - m_maxLevel) + 3;
+    const std::size_t begin = startOfRun(codes, node.coveredBegin, groupShift);
+    const std::size_t end = endOfRun(codes, node.coveredBegin, m_cloud->sortedEnd(), groupShift);
+    const auto count = static_cast<std::uint32_t>(end - begin);
+    return {static_cast<std::uint32_t>(begin), count, count};
 }
 
 PublishedCut Hierarchy::publishedCut() const {
@@ -77,9 +115,8 @@ void Hierarchy::publishNodes(int level) {
 
 void Hierarchy::appendInsertion(const CutInsertion& insertion) {
     auto& entries = m_insertions.entries;
-    assert(entries.size() == 0 ||
-           morton::span(entries[entries.size() - 1].leafCode, m_maxLevel) <
-               morton::span(insertion.leafCode, m_maxLevel));
+    assert(entries.size() == 0 || morton::span(entries[entries.size() - 1].leafCode, m_maxLevel) <
+                                      morton::span(insertion.leafCode, m_maxLevel));
     entries.push_back(insertion);
 }
 

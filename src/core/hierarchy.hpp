@@ -20,7 +20,8 @@
 #include "octree_node.hpp"
 #include "sample_store.hpp"
 #include "sorted_cloud.hpp"
-#include "splat_attributes.hpp"
+#include "splat_estimator.hpp"
+#include "stored_splats.hpp"
 
 #include <array>
 #include <atomic>
@@ -47,10 +48,16 @@ struct PublishedCut {
 // the cut as a placeholder and becomes a node when fix reaches its level. Either way the entry
 // names the leaf itself, and entries are in span order (the order of concatenation).
 struct CutInsertion {
-    morton::Code leafCode = 0;       // the leaf's own code, at its own level
-    std::uint32_t coveredBegin = 0;  // the SortedCloud range the leaf covers
+    morton::Code leafCode = 0;      // the leaf's own code, at its own level
+    std::uint32_t coveredBegin = 0; // the SortedCloud range the leaf covers
     std::uint32_t coveredCount = 0;
     std::chrono::steady_clock::time_point publishedAt{}; // when the builder published it
+};
+
+// Where the splat attributes of a hierarchy's points come from.
+enum class SplatSource {
+    Estimated, // a build: estimated per node when asked for (splat_estimator.hpp)
+    Stored,    // a loaded .omh file: one stored record per held point (stored_splats.hpp)
 };
 
 class Hierarchy {
@@ -59,7 +66,8 @@ public:
 
     static constexpr std::size_t kNodesPerChunk = 1024;
 
-    Hierarchy(std::shared_ptr<const SortedCloud> cloud, int maxLevel);
+    Hierarchy(std::shared_ptr<const SortedCloud> cloud, int maxLevel,
+              SplatSource splatSource = SplatSource::Estimated);
 
     Hierarchy(const Hierarchy&) = delete;
     Hierarchy& operator=(const Hierarchy&) = delete;
@@ -67,7 +75,10 @@ public:
     int maxLevel() const { return m_maxLevel; }
     const SortedCloud& cloud() const { return *m_cloud; }
     const std::shared_ptr<const SortedCloud>& sharedCloud() const { return m_cloud; }
-    const SplatAttributes& splats() const { return m_splats; }
+    // True when splat normals are estimated (the cloud has no normals of its own).
+    bool estimatesNormals() const { return !m_cloud->attributes().has(Attribute::Normal); }
+    // The stored attributes of a loaded hierarchy; nullptr for a build.
+    const StoredSplats* storedSplats() const { return m_storedSplats.get(); }
 
     // ---- Reader side: any thread, no locks. ----
 
@@ -79,6 +90,14 @@ public:
     const OctreeNode& node(int level, std::size_t index) const {
         return m_levels[level]->nodes[index];
     }
+    // The splat attributes of the points `node` (a published node) holds, in its order: the
+    // stored ones, or an estimate from the node's points. Any thread; `scratch` is the caller's.
+    void nodeSplats(const OctreeNode& node, NodeSplats& out, SplatScratch& scratch) const;
+    // What a node with too few points for an estimate of its own borrows its shape from: a
+    // maxLevel leaf its sibling group (inserted whole, so published with it), a node holding a
+    // sample its covered range.
+    SparseSplatRegion sparseSplatRegion(const OctreeNode& node) const;
+
     // Index of the node with `code` among the first `count` nodes of its level (Morton order).
     std::optional<std::size_t> findNode(morton::Code code, std::size_t count) const;
 
@@ -103,9 +122,7 @@ public:
         return m_insertions.published.load(std::memory_order_acquire);
     }
     // `index` must be below an insertionCount() this thread loaded.
-    const CutInsertion& insertion(std::size_t index) const {
-        return m_insertions.entries[index];
-    }
+    const CutInsertion& insertion(std::size_t index) const { return m_insertions.entries[index]; }
 
     // ---- Builder side: one thread. ----
 
@@ -113,7 +130,7 @@ public:
     std::size_t appendNode(int level, const OctreeNode& node);
     std::size_t builtNodeCount(int level) const { return m_levels[level]->nodes.size(); }
     std::uint32_t* allocateSamples(std::size_t count) { return m_samples.allocate(count); }
-    SplatAttributes& mutableSplats() { return m_splats; }
+    StoredSplats& mutableStoredSplats() { return *m_storedSplats; } // SplatSource::Stored only
 
     void publishNodes(int level);
     // Appends to the insertion log (span order); not visible before publishInsertions().
@@ -127,7 +144,7 @@ public:
     std::size_t nodeBytes() const;
     std::size_t sampleBytes() const { return m_samples.bytesAllocated(); }
     std::size_t insertionLogBytes() const { return m_insertions.entries.bytesAllocated(); }
-    std::size_t splatBytes() const { return m_splats.bytesResident(); }
+    std::size_t splatBytes() const { return m_storedSplats ? m_storedSplats->bytesResident() : 0; }
 
 private:
     struct Level {
@@ -150,7 +167,7 @@ private:
     std::vector<std::unique_ptr<Level>> m_levels;
     InsertionLog m_insertions; // every leaf covers at least one point: capacity = the cloud's
     SampleStore m_samples;
-    SplatAttributes m_splats;
+    std::unique_ptr<StoredSplats> m_storedSplats; // SplatSource::Stored only
     std::atomic<morton::Code> m_cutDelimiter{0};
     std::atomic<std::uint64_t> m_epoch{0};
     std::atomic<bool> m_complete{false};

@@ -74,8 +74,6 @@ void draftParent(const Hierarchy& hierarchy, const ObliqueCut& cut, const BuildO
             out.samples.resize(out.samples.size() + leaf.pointCount);
             sampleRange(placeholder.coveredBegin, placeholder.coveredCount,
                         std::span(out.samples).subspan(draft.sampleOffset));
-            leaf.splatScale = static_cast<float>(
-                std::sqrt(static_cast<double>(placeholder.coveredCount) / leaf.pointCount));
         }
         out.drafts.push_back(draft);
         return;
@@ -104,7 +102,6 @@ void draftParent(const Hierarchy& hierarchy, const ObliqueCut& cut, const BuildO
     draft.sampleOffset = static_cast<std::uint32_t>(out.samples.size());
     out.samples.resize(out.samples.size() + parent.pointCount);
     sampleChildren(children, std::span(out.samples).subspan(draft.sampleOffset));
-    parent.splatScale = parentSplatScale(children, parent.pointCount);
     out.drafts.push_back(draft);
 }
 
@@ -117,7 +114,6 @@ public:
     explicit Worker(int threads) : arena(threads > 0 ? threads : tbb::task_arena::automatic) {}
 
     tbb::task_arena arena;
-    tbb::enumerable_thread_specific<SplatScratch> splatScratch;
     std::vector<WorklistResult> results;
     WorklistResult merged;
     std::vector<std::pair<const WorklistResult*, std::size_t>> order;
@@ -267,8 +263,8 @@ bool HierarchyBuilder::waitForWork(bool passComplete, std::size_t& available, bo
 
 void HierarchyBuilder::insertInput(std::size_t available, bool inputEnded) {
     const int maxLevel = m_options.maxLevel;
-    // Whole sibling groups only: leaf collapse must see a leaf's siblings, and a sparse leaf
-    // estimates its splats from its siblings' points.
+    // Whole sibling groups only: leaf collapse must see a leaf's siblings, and a sparse leaf's
+    // splat estimate borrows its siblings' points (Hierarchy::sparseSplatRegion).
     const int groupShift = 3 * (morton::kMaxLevel - maxLevel) + 3;
     const std::span<const morton::Code> codes = m_cloud->codes();
     const std::size_t end =
@@ -302,28 +298,6 @@ void HierarchyBuilder::insertInput(std::size_t available, bool inputEnded) {
     const auto collapsed = [&](std::size_t run) {
         return collapse && groupSize(run) == 1;
     };
-
-    // Splat attributes: the heavy part of a leaf, one worklist of leaves per task.
-    const std::size_t worklistSize = m_options.worklistSize;
-    const std::size_t worklists = (runs.size() + worklistSize - 1) / worklistSize;
-    SplatAttributes& splats = m_hierarchy->mutableSplats();
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, worklists, 1),
-        [&](const tbb::blocked_range<std::size_t>& range) {
-            SplatScratch& scratch = worker.splatScratch.local();
-            for (std::size_t w = range.begin(); w < range.end(); ++w) {
-                const std::size_t last = std::min(runs.size(), (w + 1) * worklistSize);
-                for (std::size_t i = w * worklistSize; i < last; ++i) {
-                    const LeafRun& first = runs[groupFirst[groupOf[i]]];
-                    const LeafRun& lastRun = runs[groupFirst[groupOf[i] + 1] - 1];
-                    splats.estimateLeaf(runs[i].begin, runs[i].begin + runs[i].count,
-                                        collapsed(i) ? maxLevel - 1 : maxLevel, first.begin,
-                                        lastRun.begin + lastRun.count, scratch);
-                }
-            }
-        },
-        tbb::simple_partitioner());
-    m_stats.worklists += worklists;
 
     std::vector<CutRoot>& roots = worker.roots;
     roots.clear();
@@ -517,8 +491,8 @@ void HierarchyBuilder::publishStatistics() {
         LevelStatistics& levelStats = m_stats.levels[static_cast<std::size_t>(level)];
         const std::span<const CutRoot> roots = m_cut.roots(level);
         levelStats.cutRoots = roots.size();
-        levelStats.placeholdersPending = static_cast<std::uint64_t>(
-            std::count_if(roots.begin(), roots.end(), [](const CutRoot& r) { return r.placeholder; }));
+        levelStats.placeholdersPending = static_cast<std::uint64_t>(std::count_if(
+            roots.begin(), roots.end(), [](const CutRoot& r) { return r.placeholder; }));
     }
     m_stats.nodeBytes = m_hierarchy->nodeBytes();
     m_stats.sampleBytes = m_hierarchy->sampleBytes();

@@ -4,9 +4,9 @@
 // Threads. The producer (the sorter's or the .oms reader's thread) only announces ranges:
 // onSortedRange() records the new end of the published prefix and wakes the builder's master
 // thread, so producing never waits for building. The master thread repeats fix passes:
-//   1. insert: cut the new input into maxLevel leaves (holding back a run that may continue),
-//      estimate their splat attributes in parallel worklists of `worklistSize` leaves, append
-//      and publish them, and concatenate them to the cut;
+//   1. insert: cut the new input into maxLevel leaves (holding back a sibling group that may
+//      continue), append and publish them, and concatenate them to the cut (splat attributes
+//      are not built: a renderer estimates them for the nodes it draws, splat_estimator.hpp);
 //   2. fix, level by level from maxLevel up: the roots that fix moves at this level are cut
 //      into worklists of `worklistSize` roots; oneTBB workers make the parent of each sibling
 //      group in their worklist. A group cut by a worklist boundary yields the same parent in
@@ -20,7 +20,7 @@
 // Nodes are immutable once published, so a renderer reads them without locks: see
 // hierarchy.hpp for the protocol and Hierarchy::isSettled() for what may enter a front.
 //
-// The result (nodes, samples, attributes) depends only on the input and the options: not on
+// The result (nodes and samples) depends only on the input and the options: not on
 // the thread count, the worklist size, the range sizes or the timing.
 #pragma once
 

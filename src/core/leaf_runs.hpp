@@ -26,6 +26,10 @@ struct LeafRun {
 std::size_t endOfRun(std::span<const morton::Code> codes, std::size_t begin, std::size_t end,
                      int shift);
 
+// The start of the run of codes sharing codes[last] >> shift that ends at `last` (inclusive):
+// the mirror of endOfRun, searching towards the front.
+std::size_t startOfRun(std::span<const morton::Code> codes, std::size_t last, int shift);
+
 // Appends to `runs` the leaves at maxLevel of codes[begin, end).
 void findLeafRuns(std::span<const morton::Code> codes, std::size_t begin, std::size_t end,
                   int maxLevel, std::vector<LeafRun>& runs);

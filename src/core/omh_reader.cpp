@@ -44,7 +44,9 @@ std::string range(std::uint64_t begin, std::uint64_t end) {
     return "bytes " + std::to_string(begin) + "-" + std::to_string(end == 0 ? 0 : end - 1);
 }
 
-std::string levelName(int level) { return "level " + std::to_string(level); }
+std::string levelName(int level) {
+    return "level " + std::to_string(level);
+}
 
 std::uint64_t checksumOf(const std::uint8_t* bytes, std::size_t count) {
     oms::PayloadChecksum checksum;
@@ -131,8 +133,8 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     const auto version = loadLe<std::uint32_t>(header.data() + h::kVersion);
     if (version != omh::kVersion) {
         throw error(InputErrorKind::UnsupportedFeature, h::kVersion,
-                    "in the header: expected .omh format version " +
-                        std::to_string(omh::kVersion) + ", found " + std::to_string(version));
+                    "in the header: expected .omh format version " + std::to_string(omh::kVersion) +
+                        ", found " + std::to_string(version));
     }
     const auto storedChecksum = loadLe<std::uint64_t>(header.data() + h::kChecksum);
     const std::uint64_t headerChecksum = omh::smallChecksum(header.data(), h::kChecksum);
@@ -159,7 +161,8 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     info.build.collapsedLeaves = loadLe<std::uint64_t>(header.data() + h::kCollapsedLeaves);
     const int maxLevel = header[h::kMaxLevel];
     if (maxLevel < 1 || maxLevel > morton::kMaxLevel) {
-        throw malformed(h::kMaxLevel, "expected a depth of 1-21, found " + std::to_string(maxLevel));
+        throw malformed(h::kMaxLevel,
+                        "expected a depth of 1-21, found " + std::to_string(maxLevel));
     }
     info.build.maxLevel = maxLevel;
     if (header[h::kLevelCount] != maxLevel + 1) {
@@ -192,10 +195,9 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     // The builder estimates normals exactly when the cloud has none of its own.
     const bool expectedEstimate = !info.attributes.has(Attribute::Normal);
     if (splatBits != (expectedEstimate ? omh::kSplatEstimatedNormal : 0)) {
-        throw malformed(h::kSplatBits, "expected splat bits " +
-                                           std::to_string(expectedEstimate ? 1 : 0) +
-                                           " for these attributes, found " +
-                                           std::to_string(splatBits));
+        throw malformed(h::kSplatBits,
+                        "expected splat bits " + std::to_string(expectedEstimate ? 1 : 0) +
+                            " for these attributes, found " + std::to_string(splatBits));
     }
     info.estimatedNormals = expectedEstimate;
     m_layout = omh::RecordLayout::of(info.attributes, info.estimatedNormals);
@@ -318,9 +320,9 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     const std::uint64_t expectedBytes = info.footerOffset() + omh::kFooterBytes;
     if (fileBytes != expectedBytes) {
         throw error(InputErrorKind::CountMismatch, expectedBytes,
-                    "the file should end with its footer at byte " +
-                        std::to_string(expectedBytes) + ", but it has " +
-                        std::to_string(fileBytes - expectedBytes) + " more bytes");
+                    "the file should end with its footer at byte " + std::to_string(expectedBytes) +
+                        ", but it has " + std::to_string(fileBytes - expectedBytes) +
+                        " more bytes");
     }
 
     // Footer.
@@ -352,11 +354,11 @@ void OmhReader::createHierarchy() {
                              "the file holds " + std::to_string(m_header.totalPoints) +
                                  " point records; a loaded hierarchy indexes at most 2^32 - 1");
         }
-        m_cloud = std::make_shared<SortedCloud>(m_header.cube, m_header.sourceOffset,
-                                                m_header.attributes,
-                                                static_cast<std::size_t>(m_header.totalPoints),
-                                                CloudOrder::NodeOrder);
-        m_hierarchy = std::make_shared<Hierarchy>(m_cloud, m_header.build.maxLevel);
+        m_cloud = std::make_shared<SortedCloud>(
+            m_header.cube, m_header.sourceOffset, m_header.attributes,
+            static_cast<std::size_t>(m_header.totalPoints), CloudOrder::NodeOrder);
+        m_hierarchy =
+            std::make_shared<Hierarchy>(m_cloud, m_header.build.maxLevel, SplatSource::Stored);
     });
 }
 
@@ -475,7 +477,7 @@ void OmhReader::readPoints(int level, const std::vector<OctreeNode>& nodes,
     const std::size_t recordBytes = m_layout.bytes;
     const std::size_t blockRecords = std::max<std::size_t>(1, kBlockBytes / recordBytes);
     SortedCloud& cloud = *m_cloud;
-    SplatAttributes& splats = m_hierarchy->mutableSplats();
+    StoredSplats& splats = m_hierarchy->mutableStoredSplats();
     const AttributeSet attributes = m_header.attributes;
     const int shift = 3 * (morton::kMaxLevel - level);
     oms::PayloadChecksum checksum;
@@ -502,19 +504,22 @@ void OmhReader::readPoints(int level, const std::vector<OctreeNode>& nodes,
             const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
             const morton::Code code = finite ? morton::encodeUnit(p.x, p.y, p.z) : 0;
             if ((!finite || (code >> shift) != nodes[nodeIndex].code) && !firstProblem) {
-                firstProblem.emplace(InputErrorKind::MalformedValue, m_header.path,
-                                     InputLocation::byte(entry.payloadOffset + inLevel * recordBytes),
-                                     "in " + section + ", record " + std::to_string(inLevel) +
-                                         ": the position lies outside the cell of its node " +
-                                         hex(nodes[nodeIndex].code));
+                firstProblem.emplace(
+                    InputErrorKind::MalformedValue, m_header.path,
+                    InputLocation::byte(entry.payloadOffset + inLevel * recordBytes),
+                    "in " + section + ", record " + std::to_string(inLevel) +
+                        ": the position lies outside the cell of its node " +
+                        hex(nodes[nodeIndex].code));
             }
             cloud.mutableCodes()[point] = code;
             cloud.mutablePositions()[point] = p;
             if (attributes.has(Attribute::Normal)) {
-                cloud.mutableNormals()[point] = loadLe<glm::vec3>(record + m_layout.point.normalOffset);
+                cloud.mutableNormals()[point] =
+                    loadLe<glm::vec3>(record + m_layout.point.normalOffset);
             }
             if (attributes.has(Attribute::Color)) {
-                cloud.mutableColors()[point] = loadLe<glm::u8vec3>(record + m_layout.point.colorOffset);
+                cloud.mutableColors()[point] =
+                    loadLe<glm::u8vec3>(record + m_layout.point.colorOffset);
             }
             if (attributes.has(Attribute::Intensity)) {
                 cloud.mutableIntensities()[point] =
@@ -594,8 +599,10 @@ void OmhReader::verify() {
         if (digest != expected) {
             throw InputError(InputErrorKind::MalformedValue, m_header.path,
                              InputLocation::byte(offset),
-                             "checksum mismatch in " + section + ": the level table stores "
-                             "XXH3-64 " + hex(expected) + ", the bytes hash to " + hex(digest));
+                             "checksum mismatch in " + section +
+                                 ": the level table stores "
+                                 "XXH3-64 " +
+                                 hex(expected) + ", the bytes hash to " + hex(digest));
         }
     };
     // Header, level table and footer were verified at open.

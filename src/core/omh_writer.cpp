@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cstring>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 #include <vector>
 
 namespace omicron {
@@ -30,11 +32,12 @@ std::uint8_t childMask(const Hierarchy& hierarchy, int level, const OctreeNode& 
 class RecordSink {
 public:
     RecordSink(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::RecordLayout& layout)
-        : m_file(file), m_cloud(hierarchy.cloud()), m_splats(hierarchy.splats()),
-          m_layout(layout),
+        : m_file(file), m_cloud(hierarchy.cloud()), m_layout(layout),
           m_block(std::max<std::size_t>(1, kBlockBytes / layout.bytes) * layout.bytes) {}
 
-    void add(std::uint32_t index) {
+    // One held point of a node and its splat attributes (`estimatedNormal` only stored when
+    // the layout has room for it).
+    void add(std::uint32_t index, std::uint16_t encodedRadius, std::uint32_t estimatedNormal) {
         if (m_used == m_block.size()) {
             flush();
         }
@@ -50,9 +53,9 @@ public:
         if (attributes.has(Attribute::Intensity)) {
             store(record + m_layout.point.intensityOffset, m_cloud.intensities()[index]);
         }
-        store(record + m_layout.radiusOffset, m_splats.encodedRadius(index));
-        if (m_splats.estimatesNormals()) {
-            store(record + m_layout.estimatedNormalOffset, m_splats.encodedNormal(index));
+        store(record + m_layout.radiusOffset, encodedRadius);
+        if (m_layout.estimatedNormalOffset != 0) {
+            store(record + m_layout.estimatedNormalOffset, estimatedNormal);
         }
         m_used += m_layout.bytes;
     }
@@ -74,11 +77,52 @@ private:
 
     AtomicFileWriter& m_file;
     const SortedCloud& m_cloud;
-    const SplatAttributes& m_splats;
     omh::RecordLayout m_layout;
     std::vector<std::uint8_t> m_block;
     std::size_t m_used = 0;
     std::unique_ptr<oms::PayloadChecksum> m_checksum = std::make_unique<oms::PayloadChecksum>();
+};
+
+// The splat attributes of the nodes in file order, estimated a batch of nodes at a time in
+// parallel (the writer itself is sequential): a save pays for every node's estimate once.
+class NodeSplatBatches {
+public:
+    explicit NodeSplatBatches(const Hierarchy& hierarchy) : m_hierarchy(hierarchy) {}
+
+    // Nodes are asked for in order: level by level, each level from index 0.
+    const NodeSplats& of(int level, std::size_t index) {
+        if (level != m_level || index >= m_batchEnd) {
+            fill(level, index);
+        }
+        return m_batch[index - m_batchBegin];
+    }
+
+private:
+    void fill(int level, std::size_t begin) {
+        const std::size_t nodes = m_hierarchy.nodeCount(level);
+        // Batches of about kBatchPoints held points keep memory bounded.
+        std::size_t end = begin, points = 0;
+        while (end < nodes && (end == begin || points < kBatchPoints)) {
+            points += m_hierarchy.node(level, end).pointCount;
+            ++end;
+        }
+        m_level = level;
+        m_batchBegin = begin;
+        m_batchEnd = end;
+        m_batch.resize(end - begin);
+        tbb::parallel_for(begin, end, [&](std::size_t i) {
+            m_hierarchy.nodeSplats(m_hierarchy.node(level, i), m_batch[i - begin],
+                                   m_scratch.local());
+        });
+    }
+
+    static constexpr std::size_t kBatchPoints = std::size_t{1} << 20;
+    const Hierarchy& m_hierarchy;
+    tbb::enumerable_thread_specific<SplatScratch> m_scratch;
+    std::vector<NodeSplats> m_batch;
+    int m_level = -1;
+    std::size_t m_batchBegin = 0;
+    std::size_t m_batchEnd = 0;
 };
 
 } // namespace
@@ -96,7 +140,9 @@ omh::BuildInfo omhBuildInfo(const BuildOptions& options, const BuildStatistics& 
 
 void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::BuildInfo& build,
               const OmhWriteOptions& options) {
-    const auto fail = [&](const std::string& what) { throw OutputError(path + ": " + what); };
+    const auto fail = [&](const std::string& what) {
+        throw OutputError(path + ": " + what);
+    };
     if (!hierarchy.publishedCut().complete) {
         fail("the hierarchy is not complete; only a finished build can be saved");
     }
@@ -108,8 +154,9 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
     omh::Header header;
     header.build = build;
     header.attributes = cloud.attributes();
-    header.estimatedNormals = hierarchy.splats().estimatesNormals();
-    const omh::RecordLayout layout = omh::RecordLayout::of(header.attributes, header.estimatedNormals);
+    header.estimatedNormals = hierarchy.estimatesNormals();
+    const omh::RecordLayout layout =
+        omh::RecordLayout::of(header.attributes, header.estimatedNormals);
     header.recordBytes = layout.bytes;
     header.cube = cloud.cube();
     header.sourceOffset = cloud.sourceOffset();
@@ -172,12 +219,15 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
     }
 
     RecordSink sink(file, hierarchy, layout);
+    NodeSplatBatches splats(hierarchy);
     for (int level = 0; level < levels; ++level) {
         omh::LevelEntry& entry = header.levels[static_cast<std::size_t>(level)];
         for (std::size_t i = 0; i < entry.nodes; ++i) {
             const OctreeNode& node = hierarchy.node(level, i);
+            const NodeSplats& nodeSplats = splats.of(level, i);
             for (std::uint32_t p = 0; p < node.pointCount; ++p) {
-                sink.add(node.heldPoint(p));
+                sink.add(node.heldPoint(p), nodeSplats.radii[p],
+                         nodeSplats.normals.empty() ? 0u : nodeSplats.normals[p]);
             }
         }
         entry.payloadChecksum = sink.finishSection();

@@ -24,8 +24,4 @@ void sampleChildren(std::span<const OctreeNode* const> children, std::span<std::
 // The same over the SortedCloud range [begin, begin + count) (a paper-collapsed leaf).
 void sampleRange(std::uint32_t begin, std::uint32_t count, std::span<std::uint32_t> out);
 
-// Splat scale of a node keeping `kept` points so that its splats cover the area of the
-// children's: sqrt(sum(childPoints x childScale^2) / kept). Leaves have scale 1.
-float parentSplatScale(std::span<const OctreeNode* const> children, std::uint32_t kept);
-
 } // namespace omicron

@@ -6,8 +6,8 @@
 
 #include <QElapsedTimer>
 #include <algorithm>
-#include <glm/gtc/type_ptr.hpp>
 #include <cmath>
+#include <glm/gtc/type_ptr.hpp>
 
 namespace omicron {
 
@@ -19,6 +19,8 @@ constexpr float kMaxPointPx = 64.0f;
 // Splat visibility pass: splats pushed back by this many radii so that overlapping splats of
 // one surface pass the depth test of the accumulation pass and blend.
 constexpr float kSplatDepthOffsetRadii = 1.0f;
+// Nodes packed per parallel batch: bounds the memory of packed vertices waiting for upload.
+constexpr std::size_t kPackBatchBytes = std::size_t{8} << 20;
 // Screenshots: most front evaluations spent converging before the image is taken.
 constexpr int kMaxSettleEvaluations = 256;
 
@@ -124,7 +126,8 @@ void CloudNode::evaluateFront(RenderContext& context) {
     FrontCamera camera;
     camera.viewProjection = context.projection * context.view;
     camera.eye = context.camera->eye();
-    camera.pixelsPerUnitAtUnitDistance = context.camera->pixelsPerUnitAtUnitDistance(context.heightPx);
+    camera.pixelsPerUnitAtUnitDistance =
+        context.camera->pixelsPerUnitAtUnitDistance(context.heightPx);
     FrontOptions options;
     options.projectionThresholdPx = settings.projectionThresholdPx;
     options.pointBudget = settings.pointBudget;
@@ -137,7 +140,8 @@ void CloudNode::evaluateFront(RenderContext& context) {
         const FrontEvaluation evaluation = m_front->evaluate(camera, options);
         ++evaluations;
         const bool changed = evaluation.placeholdersInserted + evaluation.substituted +
-                                 evaluation.branched + evaluation.pruned > 0;
+                                 evaluation.branched + evaluation.pruned >
+                             0;
         if (!context.settle || (!changed && evaluation.finishedSweep) ||
             evaluations >= kMaxSettleEvaluations) {
             break;
@@ -148,9 +152,14 @@ void CloudNode::evaluateFront(RenderContext& context) {
     context.stats->placeholders = m_front->placeholderCount();
 }
 
+const OctreeNode& CloudNode::nodeOf(const DrawItem& item) const {
+    return m_hierarchy->node(item.level, item.index);
+}
+
 void CloudNode::collectDrawList(RenderContext& context) {
     m_drawList.clear();
-    const double capacity = std::max<double>(1.0, static_cast<double>(m_hierarchy->cloud().capacity()));
+    const double capacity =
+        std::max<double>(1.0, static_cast<double>(m_hierarchy->cloud().capacity()));
     for (const FrontEntry& entry : m_front->entries()) {
         if (entry.placeholder || !entry.visible) {
             continue;
@@ -177,15 +186,32 @@ void CloudNode::collectDrawList(RenderContext& context) {
     }
     std::stable_sort(missing.begin(), missing.end(),
                      [](const DrawItem* a, const DrawItem* b) { return a->level < b->level; });
+    // Nodes are packed (splat attributes estimated) in parallel, a batch at a time, then
+    // uploaded here on the GL thread.
     std::size_t uploadedBytes = 0;
-    for (DrawItem* item : missing) {
-        if (!context.settle && uploadedBytes >= context.settings->uploadBudgetBytes) {
-            break;
+    std::size_t next = 0;
+    while (next < missing.size() &&
+           (context.settle || uploadedBytes < context.settings->uploadBudgetBytes)) {
+        const std::size_t batchBegin = next;
+        std::size_t batchBytes = 0;
+        while (
+            next < missing.size() && (next == batchBegin || batchBytes < kPackBatchBytes) &&
+            (context.settle || uploadedBytes + batchBytes < context.settings->uploadBudgetBytes)) {
+            batchBytes += std::size_t{nodeOf(*missing[next]).pointCount} * sizeof(PointVertex);
+            ++next;
         }
-        packNodeVertices(*m_hierarchy, m_hierarchy->node(item->level, item->index), m_scratch);
-        item->buffer = &m_cache.upload(*context.gl, item->key, m_scratch, m_frame);
-        uploadedBytes += item->buffer->bytes;
-        ++context.stats->uploads;
+        const std::size_t batchSize = next - batchBegin;
+        m_packNodes.clear();
+        for (std::size_t i = batchBegin; i < next; ++i) {
+            m_packNodes.push_back(&nodeOf(*missing[i]));
+        }
+        packNodesVertices(*m_hierarchy, m_packNodes, m_packed);
+        for (std::size_t i = 0; i < batchSize; ++i) {
+            DrawItem* item = missing[batchBegin + i];
+            item->buffer = &m_cache.upload(*context.gl, item->key, m_packed[i], m_frame);
+            uploadedBytes += item->buffer->bytes;
+            ++context.stats->uploads;
+        }
     }
 }
 
@@ -220,7 +246,8 @@ int CloudNode::effectiveColorMode(const RenderSettings& settings) const {
 void CloudNode::setCommonUniforms(QOpenGLShaderProgram& program, const RenderContext& context,
                                   float depthOffset) {
     const RenderSettings& settings = *context.settings;
-    program.setUniformValue("u_view", QMatrix4x4(glm::value_ptr(glm::mat4(context.view))).transposed());
+    program.setUniformValue("u_view",
+                            QMatrix4x4(glm::value_ptr(glm::mat4(context.view))).transposed());
     program.setUniformValue("u_projection",
                             QMatrix4x4(glm::value_ptr(glm::mat4(context.projection))).transposed());
     program.setUniformValue(

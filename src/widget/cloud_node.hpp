@@ -5,6 +5,7 @@
 
 #include "front.hpp"
 #include "node_buffer_cache.hpp"
+#include "node_vertices.hpp"
 #include "scene_node.hpp"
 #include "splat_target.hpp"
 
@@ -55,10 +56,12 @@ private:
         const NodeBufferCache::Buffer* buffer;
     };
 
+    const OctreeNode& nodeOf(const DrawItem& item) const;
     void evaluateFront(RenderContext& context);
     void collectDrawList(RenderContext& context);
     void uploadPreview(QOpenGLExtraFunctions& gl);
-    void setCommonUniforms(QOpenGLShaderProgram& program, const RenderContext& context, float depthOffset);
+    void setCommonUniforms(QOpenGLShaderProgram& program, const RenderContext& context,
+                           float depthOffset);
     void bindVertexLayout(QOpenGLExtraFunctions& gl, unsigned vbo);
     void drawItems(RenderContext& context, QOpenGLShaderProgram& program);
     void drawPreview(RenderContext& context);
@@ -69,7 +72,9 @@ private:
     std::shared_ptr<const Hierarchy> m_hierarchy;
     std::unique_ptr<Front> m_front;
     NodeBufferCache m_cache;
-    std::vector<PointVertex> m_scratch;
+    // Vertices of the nodes uploaded next, packed in parallel.
+    std::vector<const OctreeNode*> m_packNodes;
+    std::vector<std::vector<PointVertex>> m_packed;
     std::vector<DrawItem> m_drawList;
     std::uint64_t m_frame = 0;
     bool m_hierarchyChanged = false;

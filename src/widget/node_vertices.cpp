@@ -1,9 +1,12 @@
 #include "node_vertices.hpp"
 
 #include "hierarchy.hpp"
+#include "splat_encoding.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 
 namespace omicron {
 
@@ -28,9 +31,12 @@ std::uint32_t packNormal2101010(float x, float y, float z) {
 }
 
 void packNodeVertices(const Hierarchy& hierarchy, const OctreeNode& node,
-                      std::vector<PointVertex>& out) {
+                      std::vector<PointVertex>& out, NodePackScratch& scratch) {
     const SortedCloud& cloud = hierarchy.cloud();
-    const SplatAttributes& splats = hierarchy.splats();
+    hierarchy.nodeSplats(node, scratch.splats, scratch.estimate);
+    const NodeSplats& splats = scratch.splats;
+    const bool estimatedNormals = !splats.normals.empty();
+    const auto inputNormals = cloud.normals();
     const auto positions = cloud.positions();
     const auto colors = cloud.colors();
     const auto intensities = cloud.intensities();
@@ -53,10 +59,22 @@ void packNodeVertices(const Hierarchy& hierarchy, const OctreeNode& node,
             vertex.r = vertex.g = vertex.b = 255;
         }
         vertex.intensity = hasIntensity ? packIntensity(intensities[point]) : 0;
-        const glm::vec3 normal = splats.normal(point);
+        const glm::vec3 normal =
+            estimatedNormals ? decodeOctahedral(splats.normals[i]) : inputNormals[point];
         vertex.normal = packNormal2101010(normal.x, normal.y, normal.z);
-        vertex.radius = splats.radius(point) * node.splatScale;
+        vertex.radius = decodeRadius(splats.radii[i]) * node.splatScale;
     }
+}
+
+void packNodesVertices(const Hierarchy& hierarchy, std::span<const OctreeNode* const> nodes,
+                       std::vector<std::vector<PointVertex>>& out) {
+    if (out.size() < nodes.size()) {
+        out.resize(nodes.size());
+    }
+    tbb::enumerable_thread_specific<NodePackScratch> scratch;
+    tbb::parallel_for(std::size_t{0}, nodes.size(), [&](std::size_t i) {
+        packNodeVertices(hierarchy, *nodes[i], out[i], scratch.local());
+    });
 }
 
 } // namespace omicron

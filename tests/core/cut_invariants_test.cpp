@@ -58,7 +58,6 @@ public:
         parent.pointCount = sampleSize(childPoints, m_ratio);
         std::vector<std::uint32_t> samples(parent.pointCount);
         sampleChildren(children, samples);
-        parent.splatScale = parentSplatScale(children, parent.pointCount);
         if (corrupt) {
             corrupt(parent, samples);
         }

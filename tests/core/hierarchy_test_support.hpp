@@ -283,10 +283,19 @@ inline std::uint64_t fingerprint(const Hierarchy& hierarchy) {
             }
         }
     }
-    const SplatAttributes& splats = hierarchy.splats();
-    for (std::size_t p = 0; p < hierarchy.cloud().sortedEnd(); ++p) {
-        print.add(splats.encodedRadius(p));
-        print.add(splats.normal(p));
+    // The splat attributes a renderer would draw every node with.
+    NodeSplats splats;
+    SplatScratch scratch;
+    for (int level = 0; level <= hierarchy.maxLevel(); ++level) {
+        for (std::size_t i = 0; i < hierarchy.nodeCount(level); ++i) {
+            hierarchy.nodeSplats(hierarchy.node(level, i), splats, scratch);
+            for (const std::uint16_t radius : splats.radii) {
+                print.add(radius);
+            }
+            for (const std::uint32_t normal : splats.normals) {
+                print.add(normal);
+            }
+        }
     }
     return print.value();
 }

@@ -43,6 +43,69 @@ TEST(LeafRuns, EndOfRunMatchesALinearScanForEveryRunLength) {
     }
 }
 
+// Runs found by comparing every code with the one before it.
+std::vector<LeafRun> referenceRuns(const std::vector<morton::Code>& codes, std::size_t begin,
+                                   std::size_t end, int level) {
+    std::vector<LeafRun> runs;
+    const int shift = 3 * (morton::kMaxLevel - level);
+    for (std::size_t i = begin; i < end; ++i) {
+        if (i == begin || (codes[i] >> shift) != (codes[i - 1] >> shift)) {
+            runs.push_back({codes[i] >> shift, static_cast<std::uint32_t>(i), 0});
+        }
+        ++runs.back().count;
+    }
+    return runs;
+}
+
+void expectSameRuns(const std::vector<LeafRun>& found, const std::vector<LeafRun>& expected) {
+    ASSERT_EQ(found.size(), expected.size());
+    for (std::size_t r = 0; r < found.size(); ++r) {
+        ASSERT_EQ(found[r].code, expected[r].code) << "run " << r;
+        ASSERT_EQ(found[r].begin, expected[r].begin) << "run " << r;
+        ASSERT_EQ(found[r].count, expected[r].count) << "run " << r;
+    }
+}
+
+TEST(LeafRuns, FindLeafRunsMatchesAPlainScanAcrossParallelBlocks) {
+    // Every run length from 1 to 70 (around the scan's 16-code skips), runs longer than a
+    // parallel block, and sub-ranges that start and end inside runs.
+    std::vector<std::size_t> lengths;
+    for (std::size_t length = 1; length <= 70; ++length) {
+        lengths.push_back(length);
+    }
+    lengths.push_back(40000);
+    for (std::size_t length = 70; length >= 1; --length) {
+        lengths.push_back(length);
+    }
+    lengths.push_back(100000);
+    lengths.push_back(3);
+    const int level = 6;
+    const auto codes = codesWithRuns(lengths, level);
+    for (const auto& [begin, end] : std::vector<std::pair<std::size_t, std::size_t>>{
+             {0, codes.size()}, {1, codes.size() - 1}, {2500, 2600}, {2600, 150000}}) {
+        std::vector<LeafRun> runs;
+        findLeafRuns(codes, begin, end, level, runs);
+        SCOPED_TRACE("range " + std::to_string(begin) + ".." + std::to_string(end));
+        expectSameRuns(runs, referenceRuns(codes, begin, end, level));
+    }
+}
+
+TEST(LeafRuns, FindLeafRunsOnRandomCodesAtEveryDepth) {
+    std::mt19937_64 random(17);
+    std::vector<morton::Code> codes(200000);
+    for (morton::Code& code : codes) {
+        code = (morton::Code{1} << 63) | (random() >> 1 >> 4 * (random() % 4));
+    }
+    codes.back() = ~morton::Code{0}; // the far corner: every coordinate bit set
+    std::sort(codes.begin(), codes.end());
+    for (const int level : {1, 4, 7, 12, 21}) {
+        std::vector<LeafRun> runs;
+        findLeafRuns(codes, 0, codes.size(), level, runs);
+        SCOPED_TRACE("level " + std::to_string(level));
+        expectSameRuns(runs, referenceRuns(codes, 0, codes.size(), level));
+    }
+}
+
 TEST(LeafRuns, FindLeafRunsCoversTheRangeWithOneRunPerCell) {
     const std::vector<std::size_t> lengths = {3, 1, 1, 17, 256, 2};
     const int level = 4;

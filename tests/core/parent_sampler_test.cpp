@@ -1,4 +1,4 @@
-// The parents' samples: size, distinctness, order, spread, and the splat scale.
+// The parents' samples: size, distinctness, order and spread.
 #include "parent_sampler.hpp"
 
 #include <algorithm>
@@ -30,6 +30,27 @@ TEST(ParentSampler, RangeSampleIsEvenlySpacedAndDistinct) {
     out.assign(9, 0);
     sampleRange(50, 9, out);
     EXPECT_EQ(out, (std::vector<std::uint32_t>{50, 51, 52, 53, 54, 55, 56, 57, 58}));
+}
+
+TEST(ParentSampler, RangePicksEqualTheStratifiedFormula) {
+    // Pick j of count from n is floor((2j + 1) n / (2 count)), computed without a division per
+    // pick: check against the formula in 128-bit arithmetic, also where (2j + 1) n overflows.
+    __extension__ using Wide = unsigned __int128;
+    std::vector<std::uint32_t> out;
+    for (const std::uint64_t n : {1ull, 2ull, 7ull, 100ull, 4099ull, 123457ull, 4000000000ull}) {
+        for (const std::uint64_t count : {1ull, 2ull, 3ull, 17ull, 1000ull}) {
+            if (count > n) {
+                continue;
+            }
+            out.assign(count, 0);
+            sampleRange(0, static_cast<std::uint32_t>(n), out);
+            for (std::uint64_t j = 0; j < count; ++j) {
+                const auto expected =
+                    static_cast<std::uint64_t>(Wide{2 * j + 1} * n / (Wide{2} * count));
+                ASSERT_EQ(out[j], expected) << "n " << n << " count " << count << " j " << j;
+            }
+        }
+    }
 }
 
 TEST(ParentSampler, ChildrenSampleDrawsFromEveryChildInProportion) {
@@ -66,17 +87,6 @@ TEST(ParentSampler, ChildrenSampleDrawsFromEveryChildInProportion) {
     sampleChildren(children, all);
     EXPECT_EQ(all[20], 1000u);
     EXPECT_EQ(all[39], 5009u);
-}
-
-TEST(ParentSampler, SplatScaleKeepsTheCoveredArea) {
-    std::array<OctreeNode, 2> nodes{};
-    nodes[0].pointCount = 30;
-    nodes[0].splatScale = 1.0f;
-    nodes[1].pointCount = 10;
-    nodes[1].splatScale = 2.0f;
-    const std::array<const OctreeNode*, 2> children = {&nodes[0], &nodes[1]};
-    // (30 x 1 + 10 x 4) / 7 = 10.
-    EXPECT_FLOAT_EQ(parentSplatScale(children, 7), std::sqrt(10.0f));
 }
 
 } // namespace
