@@ -11,9 +11,8 @@ std::uint64_t BuildStatistics::totalNodes() const {
 }
 
 std::size_t sortedCloudBytes(const SortedCloud& cloud) {
-    return cloud.codes().size_bytes() + cloud.positions().size_bytes() +
-           cloud.normals().size_bytes() + cloud.colors().size_bytes() +
-           cloud.intensities().size_bytes();
+    return cloud.positions().size_bytes() + cloud.normals().size_bytes() +
+           cloud.colors().size_bytes() + cloud.intensities().size_bytes();
 }
 
 void recordMilestones(std::array<double, 10>& milestones, std::uint64_t inserted,

@@ -164,8 +164,9 @@ private:
                         std::to_string(m_context.insertedPoints) + ")");
         }
         const int shift = 3 * (morton::kMaxLevel - morton::level(code));
-        const auto codes = m_hierarchy.cloud().codes();
-        if ((codes[begin] >> shift) != code || (codes[begin + count - 1] >> shift) != code) {
+        const SortedCloud& cloud = m_hierarchy.cloud();
+        if ((cloud.code(begin) >> shift) != code ||
+            (cloud.code(begin + count - 1) >> shift) != code) {
             return fail(where() + " covers input points outside its cell");
         }
         return true;

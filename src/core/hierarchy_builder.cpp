@@ -265,12 +265,12 @@ void HierarchyBuilder::insertInput(std::size_t available, bool inputEnded) {
     const int maxLevel = m_options.maxLevel;
     // Whole sibling groups only: leaf collapse must see a leaf's siblings, and a sparse leaf's
     // splat estimate borrows its siblings' points (Hierarchy::sparseSplatRegion).
-    const int groupShift = 3 * (morton::kMaxLevel - maxLevel) + 3;
-    const std::span<const morton::Code> codes = m_cloud->codes();
-    const std::size_t end =
-        insertableEnd(codes, m_insertedEnd, available, inputEnded, groupShift, kMaxInsertPoints);
+    const int groupLevel = maxLevel - 1;
+    const std::span<const glm::vec3> positions = m_cloud->positions();
+    const std::size_t end = insertableEnd(positions, m_insertedEnd, available, inputEnded,
+                                          groupLevel, kMaxInsertPoints);
     m_inputBacklog =
-        insertableEnd(codes, end, available, inputEnded, groupShift, kMaxInsertPoints) > end;
+        insertableEnd(positions, end, available, inputEnded, groupLevel, kMaxInsertPoints) > end;
     if (end == m_insertedEnd) {
         return;
     }
@@ -278,7 +278,7 @@ void HierarchyBuilder::insertInput(std::size_t available, bool inputEnded) {
     Worker& worker = *m_worker;
     std::vector<LeafRun>& runs = worker.runs;
     runs.clear();
-    findLeafRuns(codes, m_insertedEnd, end, maxLevel, runs);
+    findLeafRuns(positions, m_insertedEnd, end, maxLevel, runs);
     // Sibling groups: runs [groupFirst[g], groupFirst[g + 1]).
     std::vector<std::uint32_t>& groupOf = worker.groupOf;
     std::vector<std::size_t>& groupFirst = worker.groupFirst;

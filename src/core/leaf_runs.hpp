@@ -1,15 +1,17 @@
 // Cutting the sorted stream into the leaves of a depth-maxLevel octree.
 //
-// A leaf is a run of points whose level-21 codes share the prefix codeAtLevel(code, maxLevel);
-// Morton order makes every such run contiguous. A range handed over by the sorter can end in
-// the middle of a run (or, for leaf collapse, of a sibling group), so the tail of the input
-// is held back until the next range or the end of input says where it stops.
+// A leaf is a run of points (in Morton order) that share their cell at maxLevel; Morton order
+// makes every such run contiguous. A range handed over by the sorter can end in the middle of
+// a run (or, for leaf collapse, of a sibling group), so the tail of the input is held back
+// until the next range or the end of input says where it stops. Everything works on the
+// points' unit-cube positions (their codes are morton::encodeUnit of them).
 #pragma once
 
 #include "morton.hpp"
 
 #include <cstddef>
 #include <cstdint>
+#include <glm/vec3.hpp>
 #include <span>
 #include <vector>
 
@@ -21,25 +23,25 @@ struct LeafRun {
     std::uint32_t count = 0;
 };
 
-// The end of the index range [begin, end) of codes that share codes[begin] >> shift
-// (exponential then binary search: O(log run length)).
-std::size_t endOfRun(std::span<const morton::Code> codes, std::size_t begin, std::size_t end,
-                     int shift);
+// The end of the index range [begin, end) of points that share the cell of positions[begin] at
+// `level` (exponential then binary search: O(log run length)).
+std::size_t endOfRun(std::span<const glm::vec3> positions, std::size_t begin, std::size_t end,
+                     int level);
 
-// The start of the run of codes sharing codes[last] >> shift that ends at `last` (inclusive):
-// the mirror of endOfRun, searching towards the front.
-std::size_t startOfRun(std::span<const morton::Code> codes, std::size_t last, int shift);
+// The start of the run of points sharing the cell of positions[last] at `level` that ends at
+// `last` (inclusive): the mirror of endOfRun, searching towards the front.
+std::size_t startOfRun(std::span<const glm::vec3> positions, std::size_t last, int level);
 
-// Appends to `runs` the leaves at maxLevel of codes[begin, end).
-void findLeafRuns(std::span<const morton::Code> codes, std::size_t begin, std::size_t end,
+// Appends to `runs` the leaves at maxLevel of positions[begin, end) (in parallel blocks).
+void findLeafRuns(std::span<const glm::vec3> positions, std::size_t begin, std::size_t end,
                   int maxLevel, std::vector<LeafRun>& runs);
 
 // How far [begin, available) may be cut into leaves now, taking at most about `limit` points:
-// the returned end never splits a group of codes sharing codes >> groupShift (a leaf, or a
-// sibling group when leaf collapse must see a leaf's siblings), unless `inputEnded`. Returns
-// `begin` when the only group in reach may still grow with later input.
-std::size_t insertableEnd(std::span<const morton::Code> codes, std::size_t begin,
-                          std::size_t available, bool inputEnded, int groupShift,
+// the returned end never splits a group of points sharing their cell at `groupLevel` (a leaf,
+// or a sibling group when leaf collapse must see a leaf's siblings), unless `inputEnded`.
+// Returns `begin` when the only group in reach may still grow with later input.
+std::size_t insertableEnd(std::span<const glm::vec3> positions, std::size_t begin,
+                          std::size_t available, bool inputEnded, int groupLevel,
                           std::size_t limit);
 
 } // namespace omicron

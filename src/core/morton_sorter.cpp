@@ -197,7 +197,6 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                        [&](const tbb::blocked_range<std::size_t>& range) {
                            for (std::size_t i = range.begin(); i < range.end(); ++i) {
                                const std::uint32_t from = indices[i];
-                               cloud.mutableCodes()[base + i] = keys[i];
                                cloud.mutablePositions()[base + i] = m_input.positions[from];
                                if (!m_input.normals.empty()) {
                                    cloud.mutableNormals()[base + i] = m_input.normals[from];

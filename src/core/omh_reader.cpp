@@ -511,7 +511,6 @@ void OmhReader::readPoints(int level, const std::vector<OctreeNode>& nodes,
                         ": the position lies outside the cell of its node " +
                         hex(nodes[nodeIndex].code));
             }
-            cloud.mutableCodes()[point] = code;
             cloud.mutablePositions()[point] = p;
             if (attributes.has(Attribute::Normal)) {
                 cloud.mutableNormals()[point] =

@@ -276,7 +276,6 @@ ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptio
         std::max<std::size_t>(1, std::min(options.batchPoints, kBlockBytes / recordBytes));
     const AttributeSet attributes = m_info.attributes;
     const auto positions = cloud.mutablePositions();
-    const auto codes = cloud.mutableCodes();
     const auto normals = cloud.mutableNormals();
     const auto colors = cloud.mutableColors();
     const auto intensities = cloud.mutableIntensities();
@@ -315,7 +314,6 @@ ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptio
                         hex(code) + " is below the previous record's " + hex(previousCode) + ")");
             }
             previousCode = code;
-            codes[i] = code;
             positions[i] = p;
             if (attributes.has(Attribute::Normal)) {
                 normals[i] = load<glm::vec3>(record + m_layout.normalOffset);

@@ -109,7 +109,7 @@ void OmsWriter::append(const SortedCloud& cloud, std::size_t begin, std::size_t 
         for (std::size_t i = blockBegin; i < blockEnd; ++i, record += recordBytes) {
             const glm::vec3& p = positions[i];
             // The reader recomputes codes from the stored positions, so that is what must be
-            // in order (it equals cloud.codes() for a cloud built by the sorter).
+            // in order (SortedCloud::code does the same).
             const morton::Code code = morton::encodeUnit(p.x, p.y, p.z);
             if (code < m_lastCode) {
                 fail("point " + std::to_string(i) +

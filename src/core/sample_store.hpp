@@ -5,26 +5,28 @@
 // run is left unused (at most one run's worth per block).
 #pragma once
 
+#include "huge_page_buffer.hpp"
+
 #include <cstddef>
 #include <cstdint>
-#include <memory>
 #include <vector>
 
 namespace omicron {
 
 class SampleStore {
 public:
-    static constexpr std::size_t kBlockIndices = std::size_t{1} << 18; // 1 MiB blocks
+    // 2 MiB blocks on huge pages: a build's samples fault in a few pages, not hundreds.
+    static constexpr std::size_t kBlockIndices = kHugePageBytes / sizeof(std::uint32_t);
 
     // One writer thread. Returns space for `count` indices (count > 0).
     std::uint32_t* allocate(std::size_t count) {
         if (m_blocks.empty() || m_used + count > m_blockCapacity) {
             m_blockCapacity = count > kBlockIndices ? count : kBlockIndices;
-            m_blocks.push_back(std::make_unique_for_overwrite<std::uint32_t[]>(m_blockCapacity));
-            m_bytesAllocated += m_blockCapacity * sizeof(std::uint32_t);
+            m_blocks.emplace_back(m_blockCapacity);
+            m_bytesAllocated += m_blocks.back().bytesAllocated();
             m_used = 0;
         }
-        std::uint32_t* run = m_blocks.back().get() + m_used;
+        std::uint32_t* run = m_blocks.back().data() + m_used;
         m_used += count;
         return run;
     }
@@ -32,7 +34,7 @@ public:
     std::size_t bytesAllocated() const { return m_bytesAllocated; }
 
 private:
-    std::vector<std::unique_ptr<std::uint32_t[]>> m_blocks;
+    std::vector<HugePageArray<std::uint32_t>> m_blocks;
     std::size_t m_blockCapacity = 0;
     std::size_t m_used = 0;
     std::size_t m_bytesAllocated = 0;

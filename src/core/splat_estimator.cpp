@@ -1,6 +1,7 @@
 #include "splat_estimator.hpp"
 
 #include "splat_encoding.hpp"
+#include "unit_cell_box.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -103,36 +104,42 @@ CellEstimate estimateCell(const SplatScratch::Moments& m, double density, double
     return estimate;
 }
 
-// Splits the held points into fine cells (keys codes >> shift) and sums their moments
-// relative to `origin`. `pointAt(i)` is the cloud index of the i-th held point.
+// Splits the held points into the fine cells of `fineLevel` and sums their moments relative to
+// `origin`; a cell's key is its code at fineLevel. `pointAt(i)` is the cloud index of the i-th
+// held point.
 template <typename PointAt>
-void sumCells(const SortedCloud& cloud, std::uint32_t count, int shift, const glm::dvec3& origin,
-              PointAt pointAt, SplatScratch& scratch) {
-    const morton::Code* codes = cloud.codes().data();
+void sumCells(const SortedCloud& cloud, std::uint32_t count, int fineLevel,
+              const glm::dvec3& origin, PointAt pointAt, SplatScratch& scratch) {
     const glm::vec3* positions = cloud.positions().data();
+    const int shift = 3 * (morton::kMaxLevel - fineLevel);
+    const auto cellCode = [&](const glm::vec3& p) {
+        return morton::encodeUnit(p.x, p.y, p.z) >> shift;
+    };
     scratch.cellKeys.clear();
     scratch.cellFirst.clear();
     scratch.cellMoments.clear();
     // Sums stay in registers while a cell lasts (appending through the vector each point
-    // would force them through memory).
+    // would force them through memory). Points are tested against the cell's box (no bit
+    // interleaving); a cell's code is computed once, when it starts.
     SplatScratch::Moments current;
-    morton::Code currentKey = codes[pointAt(0)] >> shift;
+    const glm::vec3& firstPoint = positions[pointAt(0)];
+    UnitCellBox currentBox = UnitCellBox::of(firstPoint, fineLevel);
+    morton::Code currentCode = cellCode(firstPoint);
     std::uint32_t currentFirst = 0;
     for (std::uint32_t i = 0; i < count; ++i) {
-        const std::uint32_t point = pointAt(i);
-        const morton::Code key = codes[point] >> shift;
-        if (key != currentKey) {
-            scratch.cellKeys.push_back(currentKey);
+        const glm::vec3& p = positions[pointAt(i)];
+        if (!currentBox.contains(p)) {
+            scratch.cellKeys.push_back(currentCode);
             scratch.cellFirst.push_back(currentFirst);
             scratch.cellMoments.push_back(current);
             current = {};
-            currentKey = key;
+            currentBox = UnitCellBox::of(p, fineLevel);
+            currentCode = cellCode(p);
             currentFirst = i;
         }
-        const glm::vec3& p = positions[point];
         current.add(p.x - origin.x, p.y - origin.y, p.z - origin.z);
     }
-    scratch.cellKeys.push_back(currentKey);
+    scratch.cellKeys.push_back(currentCode);
     scratch.cellFirst.push_back(currentFirst);
     scratch.cellMoments.push_back(current);
     scratch.cellFirst.push_back(count);
@@ -180,7 +187,6 @@ void estimateNodeSplats(const SortedCloud& cloud, const OctreeNode& node,
     const int level = node.level();
     const int depth = fineDepth(count, level);
     const int fineLevel = level + depth;
-    const int shift = 3 * (morton::kMaxLevel - fineLevel);
     const double nodeEdge = std::ldexp(1.0, -level);
     const double fineEdge = std::ldexp(1.0, -fineLevel);
     const morton::Cell nodeCell = morton::decode(node.code);
@@ -189,11 +195,12 @@ void estimateNodeSplats(const SortedCloud& cloud, const OctreeNode& node,
     if (node.holdsRange()) {
         const std::uint32_t begin = node.coveredBegin;
         sumCells(
-            cloud, count, shift, origin, [begin](std::uint32_t i) { return begin + i; }, scratch);
+            cloud, count, fineLevel, origin, [begin](std::uint32_t i) { return begin + i; },
+            scratch);
     } else {
         const std::uint32_t* indices = node.sampleIndices;
         sumCells(
-            cloud, count, shift, origin, [indices](std::uint32_t i) { return indices[i]; },
+            cloud, count, fineLevel, origin, [indices](std::uint32_t i) { return indices[i]; },
             scratch);
     }
 

@@ -27,7 +27,6 @@ std::shared_ptr<SortedCloud> fourPointCloud() {
     std::sort(sorted.begin(), sorted.end(),
               [](const auto& a, const auto& b) { return a.first < b.first; });
     for (std::size_t i = 0; i < sorted.size(); ++i) {
-        cloud->mutableCodes()[i] = sorted[i].first;
         cloud->mutablePositions()[i] = sorted[i].second;
     }
     cloud->publish(sorted.size());
@@ -86,7 +85,7 @@ struct Fixture {
         std::vector<CutRoot> leaves;
         for (std::uint32_t i = 0; i < 4; ++i) {
             OctreeNode leaf;
-            leaf.code = morton::codeAtLevel(cloud->codes()[i], kMaxLevel);
+            leaf.code = morton::codeAtLevel(cloud->code(i), kMaxLevel);
             leaf.coveredBegin = i;
             leaf.coveredCount = 1;
             leaf.pointCount = 1;

@@ -161,7 +161,7 @@ inline std::vector<std::vector<morton::Code>> referenceNodes(const SortedCloud& 
                                                              LeafCollapse collapse) {
     std::vector<std::set<morton::Code>> levels(static_cast<std::size_t>(maxLevel) + 1);
     for (std::size_t i = 0; i < cloud.sortedEnd(); ++i) {
-        const morton::Code code = cloud.codes()[i];
+        const morton::Code code = cloud.code(i);
         for (int level = 0; level <= maxLevel; ++level) {
             levels[level].insert(morton::codeAtLevel(code, level));
         }

@@ -1,12 +1,29 @@
 // Cutting sorted codes into leaves, and how much of a growing prefix may be cut now.
 #include "leaf_runs.hpp"
 
+#include <algorithm>
+#include <glm/vec3.hpp>
 #include <gtest/gtest.h>
 #include <random>
 #include <vector>
 
 namespace omicron {
 namespace {
+
+// The centres of the level-21 cells of `codes`: points whose codes are exactly `codes`.
+std::vector<glm::vec3> toPositions(const std::vector<morton::Code>& codes) {
+    std::vector<glm::vec3> positions;
+    for (const morton::Code code : codes) {
+        const morton::Cell cell = morton::decode(code);
+        const auto centre = [](std::uint32_t c) {
+            return (static_cast<float>(c) + 0.5f) / static_cast<float>(morton::kCellsPerAxis);
+        };
+        positions.emplace_back(centre(cell.x), centre(cell.y), centre(cell.z));
+        EXPECT_EQ(morton::encodeUnit(positions.back().x, positions.back().y, positions.back().z),
+                  code);
+    }
+    return positions;
+}
 
 // Level-21 codes whose level-`level` prefixes are the given cells' codes, sorted.
 std::vector<morton::Code> codesWithRuns(const std::vector<std::size_t>& runLengths, int level) {
@@ -31,14 +48,15 @@ TEST(LeafRuns, EndOfRunMatchesALinearScanForEveryRunLength) {
     lengths.push_back(1000);
     lengths.push_back(1);
     const int level = 5;
-    const auto codes = codesWithRuns(lengths, level);
-    const int shift = 3 * (morton::kMaxLevel - level);
+    const auto positions = toPositions(codesWithRuns(lengths, level));
     std::size_t begin = 0;
     for (std::size_t length : lengths) {
-        EXPECT_EQ(endOfRun(codes, begin, codes.size(), shift), begin + length);
+        EXPECT_EQ(endOfRun(positions, begin, positions.size(), level), begin + length);
         // A range that ends inside the run stops there.
-        EXPECT_EQ(endOfRun(codes, begin, begin + (length + 1) / 2, shift),
+        EXPECT_EQ(endOfRun(positions, begin, begin + (length + 1) / 2, level),
                   begin + (length + 1) / 2);
+        // The mirror search finds the run's start from its last point.
+        EXPECT_EQ(startOfRun(positions, begin + length - 1, level), begin);
         begin += length;
     }
 }
@@ -81,10 +99,11 @@ TEST(LeafRuns, FindLeafRunsMatchesAPlainScanAcrossParallelBlocks) {
     lengths.push_back(3);
     const int level = 6;
     const auto codes = codesWithRuns(lengths, level);
+    const auto positions = toPositions(codes);
     for (const auto& [begin, end] : std::vector<std::pair<std::size_t, std::size_t>>{
-             {0, codes.size()}, {1, codes.size() - 1}, {2500, 2600}, {2600, 150000}}) {
+             {0, codes.size()}, {1, codes.size() - 1}, {2500, 2600}, {2600, codes.size() - 5}}) {
         std::vector<LeafRun> runs;
-        findLeafRuns(codes, begin, end, level, runs);
+        findLeafRuns(positions, begin, end, level, runs);
         SCOPED_TRACE("range " + std::to_string(begin) + ".." + std::to_string(end));
         expectSameRuns(runs, referenceRuns(codes, begin, end, level));
     }
@@ -98,9 +117,10 @@ TEST(LeafRuns, FindLeafRunsOnRandomCodesAtEveryDepth) {
     }
     codes.back() = ~morton::Code{0}; // the far corner: every coordinate bit set
     std::sort(codes.begin(), codes.end());
+    const auto positions = toPositions(codes);
     for (const int level : {1, 4, 7, 12, 21}) {
         std::vector<LeafRun> runs;
-        findLeafRuns(codes, 0, codes.size(), level, runs);
+        findLeafRuns(positions, 0, positions.size(), level, runs);
         SCOPED_TRACE("level " + std::to_string(level));
         expectSameRuns(runs, referenceRuns(codes, 0, codes.size(), level));
     }
@@ -111,7 +131,7 @@ TEST(LeafRuns, FindLeafRunsCoversTheRangeWithOneRunPerCell) {
     const int level = 4;
     const auto codes = codesWithRuns(lengths, level);
     std::vector<LeafRun> runs;
-    findLeafRuns(codes, 0, codes.size(), level, runs);
+    findLeafRuns(toPositions(codes), 0, codes.size(), level, runs);
     ASSERT_EQ(runs.size(), lengths.size());
     std::uint32_t begin = 0;
     for (std::size_t r = 0; r < runs.size(); ++r) {
@@ -124,25 +144,24 @@ TEST(LeafRuns, FindLeafRunsCoversTheRangeWithOneRunPerCell) {
 
 TEST(LeafRuns, InsertableEndHoldsBackTheRunThatMayContinue) {
     const int level = 3;
-    const int shift = 3 * (morton::kMaxLevel - level);
-    const auto codes = codesWithRuns({4, 5, 6}, level);
+    const auto positions = toPositions(codesWithRuns({4, 5, 6}, level));
     // Input so far ends inside the third run: it is held back.
-    EXPECT_EQ(insertableEnd(codes, 0, 12, false, shift, 1000), 9u);
+    EXPECT_EQ(insertableEnd(positions, 0, 12, false, level, 1000), 9u);
     // Input ended: everything goes.
-    EXPECT_EQ(insertableEnd(codes, 0, 12, true, shift, 1000), 12u);
+    EXPECT_EQ(insertableEnd(positions, 0, 12, true, level, 1000), 12u);
     // The per-pass limit cuts before the run it lands in.
-    EXPECT_EQ(insertableEnd(codes, 0, 15, false, shift, 6), 4u);
+    EXPECT_EQ(insertableEnd(positions, 0, 15, false, level, 6), 4u);
     // A single run longer than the limit is taken whole once its end is known...
-    EXPECT_EQ(insertableEnd(codes, 4, 15, false, shift, 2), 9u);
+    EXPECT_EQ(insertableEnd(positions, 4, 15, false, level, 2), 9u);
     // ...and waited for while it may still grow.
-    EXPECT_EQ(insertableEnd(codes, 9, 15, false, shift, 2), 9u);
-    EXPECT_EQ(insertableEnd(codes, 9, 15, true, shift, 2), 15u);
-    EXPECT_EQ(insertableEnd(codes, 15, 15, true, shift, 2), 15u);
+    EXPECT_EQ(insertableEnd(positions, 9, 15, false, level, 2), 9u);
+    EXPECT_EQ(insertableEnd(positions, 9, 15, true, level, 2), 15u);
+    EXPECT_EQ(insertableEnd(positions, 15, 15, true, level, 2), 15u);
 }
 
 TEST(LeafRuns, InsertableEndWithASiblingGroupShiftKeepsSiblingsTogether) {
     const int level = 3;
-    const int groupShift = 3 * (morton::kMaxLevel - level) + 3;
+    const int groupLevel = level - 1;
     // Two sibling leaves (cells 0 and 1 of one parent), then a leaf of another parent.
     std::vector<morton::Code> codes;
     const int leafShift = 3 * (morton::kMaxLevel - level);
@@ -151,9 +170,10 @@ TEST(LeafRuns, InsertableEndWithASiblingGroupShiftKeepsSiblingsTogether) {
         codes.push_back(cell << leafShift);
         codes.push_back((cell << leafShift) | 5);
     }
-    EXPECT_EQ(insertableEnd(codes, 0, 3, false, groupShift, 100), 0u);
-    EXPECT_EQ(insertableEnd(codes, 0, 5, false, groupShift, 100), 4u);
-    EXPECT_EQ(insertableEnd(codes, 0, 6, true, groupShift, 100), 6u);
+    const auto positions = toPositions(codes);
+    EXPECT_EQ(insertableEnd(positions, 0, 3, false, groupLevel, 100), 0u);
+    EXPECT_EQ(insertableEnd(positions, 0, 5, false, groupLevel, 100), 4u);
+    EXPECT_EQ(insertableEnd(positions, 0, 6, true, groupLevel, 100), 6u);
 }
 
 } // namespace

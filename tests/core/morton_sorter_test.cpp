@@ -4,10 +4,9 @@
 #include "point_reader.hpp"
 #include "test_files.hpp"
 
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <cstring>
+#include <gtest/gtest.h>
 #include <random>
 #include <tbb/global_control.h>
 #include <tuple>
@@ -28,21 +27,28 @@ SyntheticCloud makeCloud(Shape shape, std::size_t count, std::uint64_t seed) {
     SyntheticCloud cloud;
     cloud.info.path = "synthetic";
     cloud.info.pointCount = count;
-    cloud.info.attributes = AttributeSet(Attribute::Color) | Attribute::Normal |
-                            Attribute::Intensity;
+    cloud.info.attributes =
+        AttributeSet(Attribute::Color) | Attribute::Normal | Attribute::Intensity;
     cloud.points.attributes = cloud.info.attributes;
     std::mt19937_64 random(seed);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     for (std::size_t i = 0; i < count; ++i) {
         glm::vec3 p{unit(random), unit(random), unit(random)};
         switch (shape) {
-        case Shape::Random: break;
-        case Shape::Duplicates: p = glm::vec3(float(i % 97) / 97.0f, 0.5f, float(i % 13) / 13.0f); break;
-        case Shape::AllIdentical: p = glm::vec3(0.25f, 0.75f, 0.5f); break;
+        case Shape::Random:
+            break;
+        case Shape::Duplicates:
+            p = glm::vec3(float(i % 97) / 97.0f, 0.5f, float(i % 13) / 13.0f);
+            break;
+        case Shape::AllIdentical:
+            p = glm::vec3(0.25f, 0.75f, 0.5f);
+            break;
         case Shape::TwoClusters:
             p = (i % 2 == 0 ? glm::vec3(0.0f) : glm::vec3(0.999f)) + p * 0.001f;
             break;
-        case Shape::MaxFaces: p = glm::vec3(1.0f, i % 2 == 0 ? 1.0f : p.y, 1.0f); break;
+        case Shape::MaxFaces:
+            p = glm::vec3(1.0f, i % 2 == 0 ? 1.0f : p.y, 1.0f);
+            break;
         }
         cloud.points.positions.push_back(p);
         cloud.points.normals.push_back(glm::vec3(0.0f, 0.0f, float(i)));
@@ -88,16 +94,19 @@ SortRun sortCloud(const SyntheticCloud& cloud, int chunks, std::size_t feedBatch
         EXPECT_EQ(begin, run.ranges.empty() ? 0 : run.ranges.back().second);
         run.ranges.emplace_back(begin, end);
         for (std::size_t i = begin; i < end; ++i) {
-            if (sorted.codes()[i] < maxEmitted) {
+            if (sorted.code(i) < maxEmitted) {
                 run.prefixGuaranteeHeld = false;
             }
         }
-        maxEmitted = std::max(maxEmitted, sorted.codes()[end - 1]);
+        maxEmitted = std::max(maxEmitted, sorted.code(end - 1));
     });
     const auto sorted = sorter.cloud();
     run.complete = sorted->complete();
     const std::size_t count = sorted->sortedEnd();
-    run.codes.assign(sorted->codes().begin(), sorted->codes().begin() + count);
+    run.codes.clear();
+    for (std::size_t i = 0; i < count; ++i) {
+        run.codes.push_back(sorted->code(i));
+    }
     run.positions.assign(sorted->positions().begin(), sorted->positions().begin() + count);
     run.normals.assign(sorted->normals().begin(), sorted->normals().begin() + count);
     // Attributes travel with their point.
@@ -260,8 +269,8 @@ TEST_P(MortonSorterSharedData, SortsEveryPointOfTheFile) {
     const SortSummary summary = sortPointCloud(
         *reader, SortOptions{},
         [&](const SortedCloud& cloud, std::size_t begin, std::size_t end) {
-            prefixGuaranteeHeld = prefixGuaranteeHeld && cloud.codes()[begin] >= maxEmitted;
-            maxEmitted = cloud.codes()[end - 1];
+            prefixGuaranteeHeld = prefixGuaranteeHeld && cloud.code(begin) >= maxEmitted;
+            maxEmitted = cloud.code(end - 1);
         },
         [&](const IncrementalMortonSorter& sorter) { sorted = sorter.cloud(); });
     ASSERT_TRUE(sorted);
@@ -269,7 +278,10 @@ TEST_P(MortonSorterSharedData, SortsEveryPointOfTheFile) {
     EXPECT_TRUE(sorted->complete());
     EXPECT_EQ(summary.points, original.points.size());
     EXPECT_EQ(sorted->sortedEnd(), original.points.size());
-    const auto codes = sorted->codes().first(sorted->sortedEnd());
+    std::vector<morton::Code> codes;
+    for (std::size_t i = 0; i < sorted->sortedEnd(); ++i) {
+        codes.push_back(sorted->code(i));
+    }
     EXPECT_TRUE(std::is_sorted(codes.begin(), codes.end()));
     // Same multiset of positions: compare both sides sorted by their bit patterns.
     const auto key = [](const glm::vec3& p) {
@@ -292,8 +304,8 @@ TEST_P(MortonSorterSharedData, SortsEveryPointOfTheFile) {
 
 INSTANTIATE_TEST_SUITE_P(Files, MortonSorterSharedData,
                          ::testing::Values("bunny.ply", "autzen_trim.ply", "autzen_trim.las",
-                                           "lion.ply", "sorvilier.ply", "indoor.ply",
-                                           "dragon.ply", "autzen_south.ply"),
+                                           "lion.ply", "sorvilier.ply", "indoor.ply", "dragon.ply",
+                                           "autzen_south.ply"),
                          [](const auto& info) {
                              std::string name = info.param;
                              std::replace(name.begin(), name.end(), '.', '_');

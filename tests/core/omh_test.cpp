@@ -78,7 +78,7 @@ void expectSameHierarchy(const Hierarchy& built, const Hierarchy& loaded) {
             for (std::uint32_t p = 0; p < x.pointCount; ++p) {
                 const std::uint32_t u = x.heldPoint(p), v = y.heldPoint(p);
                 ASSERT_TRUE(sameBytes(a.positions()[u], b.positions()[v]));
-                ASSERT_EQ(a.codes()[u], b.codes()[v]);
+                ASSERT_EQ(a.code(u), b.code(v));
                 if (a.attributes().has(Attribute::Normal)) {
                     ASSERT_TRUE(sameBytes(a.normals()[u], b.normals()[v]));
                 }

@@ -96,7 +96,6 @@ void expectSameCloud(const SortedCloud& expected, const SortedCloud& got) {
     EXPECT_EQ(got.cube(), expected.cube());
     EXPECT_EQ(got.sourceOffset(), expected.sourceOffset());
     EXPECT_EQ(got.attributes(), expected.attributes());
-    EXPECT_TRUE(sameBits(expected.codes(), got.codes(), n));
     EXPECT_TRUE(sameBits(expected.positions(), got.positions(), n));
     EXPECT_EQ(got.normals().size(), expected.normals().size());
     EXPECT_TRUE(expected.normals().empty() || sameBits(expected.normals(), got.normals(), n));
@@ -125,17 +124,16 @@ struct RangeLog {
 // Every range starts where the previous one ended, is published, and continues the order.
 void expectRangesInOrder(const RangeLog& log, const SortedCloud& cloud, std::size_t count) {
     std::size_t previousEnd = 0;
-    const auto codes = cloud.codes();
     for (std::size_t r = 0; r < log.ranges.size(); ++r) {
         const auto [begin, end] = log.ranges[r];
         ASSERT_EQ(begin, previousEnd) << "range " << r;
         ASSERT_LT(begin, end) << "range " << r;
         ASSERT_GE(log.sortedEndAtCall[r], end) << "range " << r;
         if (begin > 0) {
-            ASSERT_GE(codes[begin], codes[begin - 1]) << "range " << r;
+            ASSERT_GE(cloud.code(begin), cloud.code(begin - 1)) << "range " << r;
         }
         for (std::size_t i = begin + 1; i < end; ++i) {
-            ASSERT_LE(codes[i - 1], codes[i]) << "point " << i;
+            ASSERT_LE(cloud.code(i - 1), cloud.code(i)) << "point " << i;
         }
         previousEnd = end;
     }
@@ -613,9 +611,9 @@ TEST(OmsReaderErrors, DamagedFooterIsDetectedAtOpen) {
 
 TEST(OmsReaderErrors, UnsortedFileWithValidChecksumsNamesTheRecord) {
     const SmallFile file;
-    const auto codes = file.cloud->codes();
+    const SortedCloud& cloud = *file.cloud;
     std::size_t swapAt = 25;
-    while (codes[swapAt] == codes[swapAt + 1]) {
+    while (cloud.code(swapAt) == cloud.code(swapAt + 1)) {
         ++swapAt;
     }
     std::vector<std::uint8_t> unsorted = file.bytes;
@@ -849,8 +847,6 @@ TEST(OmsWriter, RefusesACloudThatIsNotInMortonOrder) {
         {0.1f, 0.1f, 0.1f}, {0.9f, 0.9f, 0.9f}, {0.5f, 0.1f, 0.1f}};
     for (std::size_t i = 0; i < positions.size(); ++i) {
         cloud.mutablePositions()[i] = positions[i];
-        cloud.mutableCodes()[i] =
-            morton::encodeUnit(positions[i].x, positions[i].y, positions[i].z);
     }
     cloud.publish(3);
     try {
