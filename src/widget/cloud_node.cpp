@@ -256,6 +256,7 @@ void CloudNode::drawItems(RenderContext& context, QOpenGLShaderProgram& program)
     QOpenGLExtraFunctions& gl = *context.gl;
     const int levelLocation = program.uniformLocation("u_levelColor");
     const int ageLocation = program.uniformLocation("u_buildAge");
+    unsigned boundPage = 0;
     for (const DrawItem& item : m_drawList) {
         if (item.buffer == nullptr) {
             continue; // not uploaded yet (per-frame budget)
@@ -263,8 +264,11 @@ void CloudNode::drawItems(RenderContext& context, QOpenGLShaderProgram& program)
         const glm::vec3 color = levelColor(item.level);
         program.setUniformValue(levelLocation, QVector3D(color.x, color.y, color.z));
         program.setUniformValue(ageLocation, item.buildAge);
-        bindVertexLayout(gl, item.buffer->vbo);
-        gl.glDrawArrays(GL_POINTS, 0, item.buffer->pointCount);
+        if (item.buffer->vbo != boundPage) {
+            bindVertexLayout(gl, item.buffer->vbo);
+            boundPage = item.buffer->vbo;
+        }
+        gl.glDrawArrays(GL_POINTS, item.buffer->firstPoint, item.buffer->pointCount);
     }
 }
 
