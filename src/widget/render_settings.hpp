@@ -7,8 +7,11 @@
 namespace omicron {
 
 enum class RenderMode {
-    Points, // one GL point per point, screen size from the splat radius (fast)
+    Points, // one GL point per point, screen size from the splat radius
     Splats, // surface splats: visibility, Gaussian accumulation and normalisation passes
+    // The same points as Points, drawn by compute shaders (OpenGL 4.3; GL points where a
+    // context has no compute shaders).
+    ComputePoints,
 };
 
 enum class ColorMode { Rgb, Normal, Height, Intensity, Level, BuildAge };
