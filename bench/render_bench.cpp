@@ -1,8 +1,11 @@
 // render_bench FILE [--size WxH] [--frames N]: GPU frame time of CloudView on this machine's
 // OpenGL (Mesa llvmpipe in CI), on a scripted orbit around the finished hierarchy, for several
-// point budgets. Baseline in the same run: the same frames with a budget of one node (clear,
-// front, readback: what a frame costs without points), so ns_per_point isolates the points.
-// Needs a display (xvfb-run on headless machines).
+// point budgets, once with GL_POINTS (RenderMode::Points) and once with the compute point
+// rasterizer (RenderMode::ComputePoints) on the same orbit. Baseline in the same run, per
+// path: the same frames with a budget of one node (clear, front, readback and the path's fixed
+// passes: what a frame costs without points), so ns_per_point isolates the points; a
+// phase=compare line per budget gives compute / points ratios. Needs a display (xvfb-run on
+// headless machines).
 #include "bench_timing.hpp"
 #include "cloud_view.hpp"
 #include "build_pipeline.hpp"
@@ -40,8 +43,10 @@ struct PathResult {
 
 // One orbit of `frames` frames around the cloud; every frame read back (grabFramebuffer), so
 // the GPU work is finished inside the timing.
-PathResult runPath(CloudView& view, const ViewCamera& start, int frames, std::size_t budget) {
+PathResult runPath(CloudView& view, const ViewCamera& start, int frames, RenderMode mode,
+                   std::size_t budget) {
     RenderSettings settings = view.renderSettings();
+    settings.mode = mode;
     settings.pointBudget = budget;
     settings.uploadBudgetBytes = std::size_t{1} << 30; // measure drawing, not upload pacing
     view.setRenderSettings(settings);
@@ -65,6 +70,18 @@ PathResult runPath(CloudView& view, const ViewCamera& start, int frames, std::si
     return {percentile(frameMs, 0.5), percentile(frameMs, 0.95), percentile(frontMs, 0.5),
             percentile(points, 0.5)};
 }
+
+double nsPerPoint(const PathResult& result, const PathResult& baseline) {
+    const double pointMs = std::max(result.frameMsMedian - baseline.frameMsMedian, 0.0);
+    return result.pointsMedian > 0 ? pointMs * 1e6 / result.pointsMedian : 0.0;
+}
+
+struct PathChoice {
+    const char* name;
+    RenderMode mode;
+};
+constexpr PathChoice kPaths[] = {{"points", RenderMode::Points},
+                                 {"compute", RenderMode::ComputePoints}};
 
 } // namespace
 
@@ -101,21 +118,42 @@ int main(int argc, char** argv) {
     const ViewCamera start = view.camera();
     const std::string renderer = view.glRendererName().toStdString();
 
-    const PathResult empty = runPath(view, start, frames, 1);
-    std::printf("bench=render phase=baseline_no_points renderer=\"%s\" size=%dx%d frames=%d "
-                "frame_ms_median=%.2f frame_ms_p95=%.2f front_ms_median=%.3f\n",
-                renderer.c_str(), width, height, frames, empty.frameMsMedian, empty.frameMsP95,
-                empty.frontMsMedian);
+    const int computeAvailable = view.computePointsAvailable() ? 1 : 0;
+    PathResult baselines[2];
+    for (int path = 0; path < 2; ++path) {
+        baselines[path] = runPath(view, start, frames, kPaths[path].mode, 1);
+        const PathResult& empty = baselines[path];
+        std::printf("bench=render phase=baseline_no_points path=%s renderer=\"%s\" "
+                    "compute_available=%d size=%dx%d frames=%d frame_ms_median=%.2f "
+                    "frame_ms_p95=%.2f front_ms_median=%.3f\n",
+                    kPaths[path].name, renderer.c_str(), computeAvailable, width, height, frames,
+                    empty.frameMsMedian, empty.frameMsP95, empty.frontMsMedian);
+    }
     for (std::size_t budget : {std::size_t{250'000}, std::size_t{1'000'000}, std::size_t{0}}) {
-        const PathResult result = runPath(view, start, frames, budget);
-        const double pointMs = std::max(result.frameMsMedian - empty.frameMsMedian, 0.0);
-        std::printf("bench=render phase=orbit point_budget=%zu size=%dx%d frames=%d "
-                    "points_drawn_median=%.0f frame_ms_median=%.2f frame_ms_p95=%.2f "
-                    "front_ms_median=%.3f ns_per_point=%.1f fps=%.1f\n",
-                    budget, width, height, frames, result.pointsMedian, result.frameMsMedian,
-                    result.frameMsP95, result.frontMsMedian,
-                    result.pointsMedian > 0 ? pointMs * 1e6 / result.pointsMedian : 0.0,
-                    result.frameMsMedian > 0 ? 1000.0 / result.frameMsMedian : 0.0);
+        PathResult results[2];
+        double nsPer[2];
+        // Both paths on the same orbit and budget, one after the other.
+        for (int path = 0; path < 2; ++path) {
+            results[path] = runPath(view, start, frames, kPaths[path].mode, budget);
+            const PathResult& result = results[path];
+            nsPer[path] = nsPerPoint(result, baselines[path]);
+            std::printf("bench=render phase=orbit path=%s point_budget=%zu size=%dx%d frames=%d "
+                        "points_drawn_median=%.0f frame_ms_median=%.2f frame_ms_p95=%.2f "
+                        "front_ms_median=%.3f ns_per_point=%.1f fps=%.1f\n",
+                        kPaths[path].name, budget, width, height, frames, result.pointsMedian,
+                        result.frameMsMedian, result.frameMsP95, result.frontMsMedian, nsPer[path],
+                        result.frameMsMedian > 0 ? 1000.0 / result.frameMsMedian : 0.0);
+        }
+        const auto ratio = [](double compute, double points) {
+            return points > 0 ? compute / points : 0.0;
+        };
+        std::printf("bench=render phase=compare point_budget=%zu compute_available=%d "
+                    "points_ns_per_point=%.1f compute_ns_per_point=%.1f "
+                    "ns_per_point_ratio_compute_over_points=%.3f "
+                    "frame_ms_ratio_compute_over_points=%.3f faster=%s\n",
+                    budget, computeAvailable, nsPer[0], nsPer[1], ratio(nsPer[1], nsPer[0]),
+                    ratio(results[1].frameMsMedian, results[0].frameMsMedian),
+                    results[1].frameMsMedian < results[0].frameMsMedian ? "compute" : "points");
     }
     return 0;
 }

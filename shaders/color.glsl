@@ -30,7 +30,9 @@ vec3 ageRamp(float t) {
     return t < 0.5 ? mix(early, mid, t * 2.0) : mix(mid, late, t * 2.0 - 1.0);
 }
 
-vec3 pointColor(vec3 position, vec4 color, vec3 normal) {
+// The colour of a point in the current mode; the compute rasterizer passes the node's level
+// colour and build age itself (one dispatch draws many nodes), the vertex shaders the uniforms.
+vec3 pointColorOf(vec3 position, vec4 color, vec3 normal, vec3 levelColor, float buildAge) {
     if (u_colorMode == kColorNormal) {
         return length(normal) > 0.0 ? normalize(normal) * 0.5 + 0.5 : vec3(0.6);
     }
@@ -42,10 +44,14 @@ vec3 pointColor(vec3 position, vec4 color, vec3 normal) {
         return vec3(color.a);
     }
     if (u_colorMode == kColorLevel) {
-        return u_levelColor;
+        return levelColor;
     }
     if (u_colorMode == kColorBuildAge) {
-        return ageRamp(u_buildAge);
+        return ageRamp(buildAge);
     }
     return color.rgb;
+}
+
+vec3 pointColor(vec3 position, vec4 color, vec3 normal) {
+    return pointColorOf(position, color, normal, u_levelColor, u_buildAge);
 }

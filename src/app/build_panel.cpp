@@ -3,8 +3,31 @@
 #include "ui_buildpanel.h"
 
 #include <QSettings>
+#include <algorithm>
+#include <iterator>
+#include <utility>
 
 namespace omicron {
+
+namespace {
+
+// The render combo's items, in the order of ui/buildpanel.ui, with their settings names.
+constexpr std::pair<RenderMode, const char*> kRenderModes[] = {
+    {RenderMode::ComputePoints, "compute"},
+    {RenderMode::Points, "points"},
+    {RenderMode::Splats, "splats"},
+};
+
+int renderModeIndex(RenderMode mode) {
+    for (int i = 0; i < static_cast<int>(std::size(kRenderModes)); ++i) {
+        if (kRenderModes[i].first == mode) {
+            return i;
+        }
+    }
+    return 0;
+}
+
+} // namespace
 
 BuildPanel::BuildPanel(QWidget* parent)
     : QWidget(parent), m_ui(std::make_unique<Ui::BuildPanel>()) {
@@ -20,7 +43,7 @@ BuildPanel::BuildPanel(QWidget* parent)
     };
     connect(m_ui->thresholdSpin, &QDoubleSpinBox::valueChanged, this, viewEdited);
     connect(m_ui->budgetSpin, &QSpinBox::valueChanged, this, viewEdited);
-    connect(m_ui->splatCombo, &QComboBox::currentIndexChanged, this, viewEdited);
+    connect(m_ui->renderModeCombo, &QComboBox::currentIndexChanged, this, viewEdited);
 }
 
 BuildPanel::~BuildPanel() = default;
@@ -49,14 +72,16 @@ ViewParameters BuildPanel::viewParameters() const {
     ViewParameters parameters;
     parameters.projectionThresholdPx = m_ui->thresholdSpin->value();
     parameters.pointBudget = static_cast<std::size_t>(m_ui->budgetSpin->value()) * 1000;
-    parameters.splats = m_ui->splatCombo->currentIndex() == 1;
+    const int index = std::clamp(m_ui->renderModeCombo->currentIndex(), 0,
+                                 static_cast<int>(std::size(kRenderModes)) - 1);
+    parameters.renderMode = kRenderModes[index].first;
     return parameters;
 }
 
 void BuildPanel::setViewParameters(const ViewParameters& parameters) {
     m_ui->thresholdSpin->setValue(parameters.projectionThresholdPx);
     m_ui->budgetSpin->setValue(static_cast<int>(parameters.pointBudget / 1000));
-    m_ui->splatCombo->setCurrentIndex(parameters.splats ? 1 : 0);
+    m_ui->renderModeCombo->setCurrentIndex(renderModeIndex(parameters.renderMode));
 }
 
 void BuildPanel::loadSettings(const QSettings& settings) {
@@ -78,7 +103,14 @@ void BuildPanel::loadSettings(const QSettings& settings) {
         settings.value("view/projectionThresholdPx", viewDefaults.projectionThresholdPx).toDouble();
     view.pointBudget =
         settings.value("view/pointBudget", qulonglong(viewDefaults.pointBudget)).toULongLong();
-    view.splats = settings.value("view/splats", false).toBool();
+    view.renderMode = viewDefaults.renderMode;
+    const QString modeName = settings.value("view/renderMode").toString();
+    for (const auto& [mode, name] : kRenderModes) {
+        view.renderMode = modeName == QLatin1String(name) ? mode : view.renderMode;
+    }
+    if (modeName.isEmpty() && settings.value("view/splats", false).toBool()) {
+        view.renderMode = RenderMode::Splats; // written by versions before the render mode
+    }
     setViewParameters(view);
 }
 
@@ -93,7 +125,9 @@ void BuildPanel::saveSettings(QSettings& settings) const {
     const ViewParameters view = viewParameters();
     settings.setValue("view/projectionThresholdPx", view.projectionThresholdPx);
     settings.setValue("view/pointBudget", qulonglong(view.pointBudget));
-    settings.setValue("view/splats", view.splats);
+    settings.setValue("view/renderMode",
+                      QLatin1String(kRenderModes[renderModeIndex(view.renderMode)].second));
+    settings.remove("view/splats");
 }
 
 void BuildPanel::setBusy(bool busy) {

@@ -1,6 +1,6 @@
 // BuildPanel: the build parameters dock (form ui/buildpanel.ui): depth, leaf collapse, ratio,
 // worklist size, threads, sort chunks; and the render parameters that apply at once
-// (projection threshold, point budget, points or splats). Apply/Rebuild asks for a new
+// (projection threshold, point budget, render mode). Apply/Rebuild asks for a new
 // hierarchy from the kept sorted points.
 #pragma once
 

@@ -169,13 +169,23 @@ void MainWindow::connectActions() {
     connect(m_chartsPanel, &ChartsPanel::exportFailed, this, &MainWindow::showError);
 
     auto* renderModes = new QActionGroup(this);
-    renderModes->addAction(m_ui->actionPoints);
-    renderModes->addAction(m_ui->actionSplats);
+    const std::pair<QAction*, RenderMode> renderModeActions[] = {
+        {m_ui->actionComputePoints, RenderMode::ComputePoints},
+        {m_ui->actionPoints, RenderMode::Points},
+        {m_ui->actionSplats, RenderMode::Splats}};
+    for (const auto& [action, mode] : renderModeActions) {
+        renderModes->addAction(action);
+        action->setChecked(mode == ViewParameters{}.renderMode);
+        connect(action, &QAction::triggered, this, [this, mode = mode] {
+            ViewParameters parameters = m_buildPanel->viewParameters();
+            parameters.renderMode = mode;
+            m_buildPanel->setViewParameters(parameters);
+        });
+    }
     auto* colorModes = new QActionGroup(this);
     for (QAction* action : m_ui->menuColorMode->actions()) {
         colorModes->addAction(action);
     }
-    m_ui->actionPoints->setChecked(true);
     m_ui->actionColorRgb->setChecked(true);
     m_ui->actionShowCutBoundary->setChecked(true);
     m_ui->actionShowAxes->setChecked(true);
@@ -185,16 +195,6 @@ void MainWindow::connectActions() {
         edit(settings);
         m_view->setRenderSettings(settings);
     };
-    connect(m_ui->actionPoints, &QAction::triggered, this, [this] {
-        ViewParameters parameters = m_buildPanel->viewParameters();
-        parameters.splats = false;
-        m_buildPanel->setViewParameters(parameters);
-    });
-    connect(m_ui->actionSplats, &QAction::triggered, this, [this] {
-        ViewParameters parameters = m_buildPanel->viewParameters();
-        parameters.splats = true;
-        m_buildPanel->setViewParameters(parameters);
-    });
     const std::pair<QAction*, ColorMode> colors[] = {
         {m_ui->actionColorRgb, ColorMode::Rgb},
         {m_ui->actionColorNormal, ColorMode::Normal},
@@ -458,12 +458,13 @@ void MainWindow::updateStatus() {
 }
 
 void MainWindow::applyViewParameters(const ViewParameters& parameters) {
-    m_ui->actionPoints->setChecked(!parameters.splats);
-    m_ui->actionSplats->setChecked(parameters.splats);
+    m_ui->actionComputePoints->setChecked(parameters.renderMode == RenderMode::ComputePoints);
+    m_ui->actionPoints->setChecked(parameters.renderMode == RenderMode::Points);
+    m_ui->actionSplats->setChecked(parameters.renderMode == RenderMode::Splats);
     RenderSettings settings = m_view->renderSettings();
     settings.projectionThresholdPx = parameters.projectionThresholdPx;
     settings.pointBudget = parameters.pointBudget;
-    settings.mode = parameters.splats ? RenderMode::Splats : RenderMode::Points;
+    settings.mode = parameters.renderMode;
     m_view->setRenderSettings(settings);
 }
 

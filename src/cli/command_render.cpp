@@ -32,6 +32,12 @@ constexpr CameraChoice kCameras[] = {
     {"left", false, StandardView::Left},     {"right", false, StandardView::Right},
 };
 
+constexpr std::pair<const char*, RenderMode> kModes[] = {
+    {"points", RenderMode::Points},
+    {"compute", RenderMode::ComputePoints},
+    {"splats", RenderMode::Splats},
+};
+
 constexpr std::pair<const char*, ColorMode> kColors[] = {
     {"rgb", ColorMode::Rgb},     {"normal", ColorMode::Normal}, {"height", ColorMode::Height},
     {"intensity", ColorMode::Intensity}, {"level", ColorMode::Level}, {"age", ColorMode::BuildAge},
@@ -87,10 +93,16 @@ int runRender(const std::vector<std::string>& args) {
     settings.showCutBoundary = false;
     settings.pointBudget = 0; // an image of everything the threshold asks for
     if (const auto mode = parsed.value("mode")) {
-        if (*mode != "points" && *mode != "splats") {
-            throw UsageError("--mode takes points or splats, found '" + *mode + "'");
+        bool known = false;
+        for (const auto& [name, value] : kModes) {
+            if (*mode == name) {
+                settings.mode = value;
+                known = true;
+            }
         }
-        settings.mode = *mode == "splats" ? RenderMode::Splats : RenderMode::Points;
+        if (!known) {
+            throw UsageError("--mode takes points, compute or splats, found '" + *mode + "'");
+        }
     }
     if (const auto color = parsed.value("color")) {
         bool known = false;
@@ -162,7 +174,7 @@ const Command& renderCommand() {
     static const Command command{
         "render", "build a cloud's hierarchy and save an image of it (needs a display)",
         "render IN OUT.png [--camera fit|iso|top|bottom|front|back|left|right] [--size WxH] "
-        "[--mode points|splats] [--color rgb|normal|height|intensity|level|age] [--depth N] "
+        "[--mode points|compute|splats] [--color rgb|normal|height|intensity|level|age] [--depth N] "
         "[--threshold PX] [--threads T]",
         "Runs the pipeline (an unsorted cloud is sorted first; a .oms file is streamed; a .omh\n"
         "hierarchy is loaded), waits for the hierarchy, and renders it with the viewer's\n"
@@ -171,7 +183,9 @@ const Command& renderCommand() {
         "  --camera   fit (default: the cloud framed from above at an angle), or a standard view\n"
         "             (top looks down z; front looks along +y)\n"
         "  --size     image size in pixels (default 1280x800)\n"
-        "  --mode     points (default) or splats (three-pass surface splatting)\n"
+        "  --mode     compute (default: the points drawn by compute shaders, OpenGL 4.3; GL\n"
+        "             points where unavailable), points (GL points) or splats (three-pass\n"
+        "             surface splatting)\n"
         "  --color    rgb (default; height where the cloud has no colour), normal, height,\n"
         "             intensity, level (hierarchy level of each node), age (build order)\n"
         "  --depth    hierarchy depth (default 7)\n"

@@ -5,6 +5,7 @@
 #include "view_camera.hpp"
 
 #include <QElapsedTimer>
+#include <QOpenGLContext>
 #include <algorithm>
 #include <cmath>
 #include <glm/gtc/type_ptr.hpp>
@@ -96,9 +97,17 @@ void CloudNode::initializeGL(QOpenGLExtraFunctions& gl) {
         {"points.vert", "splat_accumulate.frag", {"color.glsl"}, {"splat_disc.glsl"}});
     m_normalizeProgram = buildShaderProgram({"fullscreen.vert", "splat_normalize.frag"});
     gl.glGenVertexArrays(1, &m_vao);
+    if (QOpenGLContext* context = QOpenGLContext::currentContext()) {
+        m_compute.initializeGL(*context);
+    }
     m_initialized = true;
     // A new context: every buffer has to be uploaded again.
     m_cache.abandon();
+    if (m_compute.available()) {
+        // The compute rasterizer reads a whole page through one buffer texture.
+        m_cache.setPagePoints(std::min(NodeBufferCache::kDefaultPagePoints,
+                                       m_compute.maxPageBytes() / sizeof(PointVertex)));
+    }
     m_previewVbo = 0;
 }
 
@@ -112,6 +121,7 @@ void CloudNode::releaseGL(QOpenGLExtraFunctions& gl) {
         m_previewVbo = 0;
     }
     m_splatTarget.release(gl);
+    m_compute.release(gl);
     gl.glDeleteVertexArrays(1, &m_vao);
     m_vao = 0;
     m_pointsProgram.reset();
@@ -283,6 +293,7 @@ void CloudNode::drawItems(RenderContext& context, QOpenGLShaderProgram& program)
     QOpenGLExtraFunctions& gl = *context.gl;
     const int levelLocation = program.uniformLocation("u_levelColor");
     const int ageLocation = program.uniformLocation("u_buildAge");
+    unsigned boundPage = 0;
     for (const DrawItem& item : m_drawList) {
         if (item.buffer == nullptr) {
             continue; // not uploaded yet (per-frame budget)
@@ -290,8 +301,11 @@ void CloudNode::drawItems(RenderContext& context, QOpenGLShaderProgram& program)
         const glm::vec3 color = levelColor(item.level);
         program.setUniformValue(levelLocation, QVector3D(color.x, color.y, color.z));
         program.setUniformValue(ageLocation, item.buildAge);
-        bindVertexLayout(gl, item.buffer->vbo);
-        gl.glDrawArrays(GL_POINTS, 0, item.buffer->pointCount);
+        if (item.buffer->vbo != boundPage) {
+            bindVertexLayout(gl, item.buffer->vbo);
+            boundPage = item.buffer->vbo;
+        }
+        gl.glDrawArrays(GL_POINTS, item.buffer->firstPoint, item.buffer->pointCount);
     }
 }
 
@@ -374,6 +388,32 @@ void CloudNode::drawSplats(RenderContext& context) {
     m_normalizeProgram->release();
 }
 
+void CloudNode::drawComputePoints(RenderContext& context) {
+    m_computeBatches.clear();
+    for (const DrawItem& item : m_drawList) {
+        if (item.buffer != nullptr) {
+            m_computeBatches.push_back({item.buffer->vbo, item.buffer->firstPoint,
+                                        item.buffer->pointCount, levelColor(item.level),
+                                        item.buildAge});
+        }
+    }
+    if (m_drawList.empty() && m_previewVbo != 0) {
+        m_computeBatches.push_back({m_previewVbo, 0, m_previewCount, glm::vec3(1.0f), 0.0f});
+    }
+    const bool drawn = m_compute.draw(
+        *context.gl, context.targetFramebuffer, context.widthPx, context.heightPx, m_computeBatches,
+        [&](QOpenGLShaderProgram& program) {
+            setCommonUniforms(program, context, 0.0f);
+            program.setUniformValue(
+                "u_viewProjection",
+                QMatrix4x4(glm::value_ptr(glm::mat4(context.projection * context.view)))
+                    .transposed());
+        });
+    if (!drawn) {
+        drawPoints(context); // no OpenGL 4.3, or no per-pixel images at this size
+    }
+}
+
 void CloudNode::render(RenderContext& context) {
     QOpenGLExtraFunctions& gl = *context.gl;
     ++m_frame;
@@ -394,6 +434,8 @@ void CloudNode::render(RenderContext& context) {
     gl.glEnable(GL_PROGRAM_POINT_SIZE);
     if (context.settings->mode == RenderMode::Splats) {
         drawSplats(context);
+    } else if (context.settings->mode == RenderMode::ComputePoints) {
+        drawComputePoints(context);
     } else {
         drawPoints(context);
     }

@@ -1,8 +1,9 @@
 // The scene node that draws the cloud: a Front over the attached hierarchy (or the sorter's
 // preview before anything is renderable), node buffers uploaded within the per-frame budget,
-// and the points or surface-splat passes.
+// and the points, compute-points or surface-splat passes.
 #pragma once
 
+#include "compute_rasterizer.hpp"
 #include "front.hpp"
 #include "node_buffer_cache.hpp"
 #include "node_vertices.hpp"
@@ -41,6 +42,10 @@ public:
     // The front of the last frame (empty without a hierarchy).
     const Front* front() const { return m_front.get(); }
 
+    // Whether RenderMode::ComputePoints runs the compute rasterizer in this context (else it
+    // draws GL points).
+    bool computePointsAvailable() const { return m_compute.available(); }
+
     void initializeGL(QOpenGLExtraFunctions& gl) override;
     void render(RenderContext& context) override;
     void releaseGL(QOpenGLExtraFunctions& gl) override;
@@ -67,6 +72,7 @@ private:
     void drawPreview(RenderContext& context);
     void drawPoints(RenderContext& context);
     void drawSplats(RenderContext& context);
+    void drawComputePoints(RenderContext& context);
     int effectiveColorMode(const RenderSettings& settings) const;
 
     std::shared_ptr<const Hierarchy> m_hierarchy;
@@ -94,6 +100,8 @@ private:
     std::unique_ptr<QOpenGLShaderProgram> m_accumulateProgram;
     std::unique_ptr<QOpenGLShaderProgram> m_normalizeProgram;
     SplatTarget m_splatTarget;
+    ComputeRasterizer m_compute;
+    std::vector<ComputeRasterizer::Batch> m_computeBatches;
 };
 
 } // namespace omicron

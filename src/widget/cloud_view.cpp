@@ -223,6 +223,10 @@ QString CloudView::glErrorString() const { return d->glError; }
 
 QString CloudView::glRendererName() const { return d->glRenderer; }
 
+bool CloudView::computePointsAvailable() const {
+    return d->glReady && d->cloud->computePointsAvailable();
+}
+
 void CloudView::initializeGL() {
     QOpenGLContext* glContext = context();
     d->glRenderer = QString::fromLatin1(

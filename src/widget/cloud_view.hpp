@@ -63,6 +63,10 @@ public:
     // GL_RENDERER of the context (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"); empty before it exists.
     QString glRendererName() const;
 
+    // Whether RenderMode::ComputePoints draws with compute shaders in this view's context
+    // (OpenGL 4.3); when false it draws GL points. False before the context exists.
+    bool computePointsAvailable() const;
+
     // Why nothing is drawn (no OpenGL 3.3, a shader failed); empty when all is well.
     QString glErrorString() const;
 

@@ -19,4 +19,8 @@ struct ShaderSources {
 
 std::unique_ptr<QOpenGLShaderProgram> buildShaderProgram(const ShaderSources& sources);
 
+// A compute program (GLSL 430 core, OpenGL 4.3): `snippets` then `compute`, as above.
+std::unique_ptr<QOpenGLShaderProgram> buildComputeProgram(const QString& compute,
+                                                          const QStringList& snippets = {});
+
 } // namespace omicron

@@ -12,6 +12,8 @@
 #include "main_window.hpp"
 
 #include <QAbstractItemModelTester>
+#include <QAction>
+#include <QComboBox>
 #include <QElapsedTimer>
 #include <QFile>
 #include <QImage>
@@ -38,6 +40,7 @@ private slots:
     void malformedFileShowsANamedErrorAndTheAppStaysUsable();
     void savedHierarchyOpensThroughTheFileMenu();
     void closingMidBuildReturnsPromptly();
+    void renderModeMenuAndPanelDriveTheView();
 };
 
 void TestMainWindowGL::initTestCase() {
@@ -182,6 +185,51 @@ void TestMainWindowGL::closingMidBuildReturnsPromptly() {
     // The window, its view and the service are gone, and with them the builder and its
     // threads: nothing holds the hierarchy any more.
     QVERIFY(hierarchy.expired());
+}
+
+// View -> Render Mode and the build panel's render combo are one setting: either drives the
+// view and the other follows; compute points are the default; the choice persists (and a
+// settings file of the splats-or-points era still opens in splat mode).
+void TestMainWindowGL::renderModeMenuAndPanelDriveTheView() {
+    QSettings().remove(QStringLiteral("view"));
+    {
+        MainWindow window;
+        auto* computeAction = window.findChild<QAction*>(QStringLiteral("actionComputePoints"));
+        auto* pointsAction = window.findChild<QAction*>(QStringLiteral("actionPoints"));
+        auto* splatsAction = window.findChild<QAction*>(QStringLiteral("actionSplats"));
+        auto* combo = window.buildPanel()->findChild<QComboBox*>(QStringLiteral("renderModeCombo"));
+        QVERIFY(computeAction && pointsAction && splatsAction && combo);
+        QCOMPARE(window.cloudView()->renderSettings().mode, RenderMode::ComputePoints);
+        QCOMPARE(window.buildPanel()->viewParameters().renderMode, RenderMode::ComputePoints);
+        QVERIFY(computeAction->isChecked());
+
+        pointsAction->trigger();
+        QCOMPARE(window.cloudView()->renderSettings().mode, RenderMode::Points);
+        QCOMPARE(combo->currentText(), QStringLiteral("GL points"));
+
+        combo->setCurrentIndex(combo->findText(QStringLiteral("surface splats")));
+        QCOMPARE(window.cloudView()->renderSettings().mode, RenderMode::Splats);
+        QVERIFY(splatsAction->isChecked());
+        QVERIFY(!pointsAction->isChecked());
+
+        computeAction->trigger();
+        QCOMPARE(window.cloudView()->renderSettings().mode, RenderMode::ComputePoints);
+        QCOMPARE(combo->currentText(), QStringLiteral("compute points"));
+        pointsAction->trigger();
+        window.close();
+    }
+    {
+        MainWindow again;
+        QCOMPARE(again.cloudView()->renderSettings().mode, RenderMode::Points);
+        again.close();
+    }
+    QSettings().remove(QStringLiteral("view/renderMode"));
+    QSettings().setValue(QStringLiteral("view/splats"), true);
+    {
+        MainWindow legacy;
+        QCOMPARE(legacy.cloudView()->renderSettings().mode, RenderMode::Splats);
+    }
+    QSettings().remove(QStringLiteral("view"));
 }
 
 int main(int argc, char* argv[]) {
