@@ -25,6 +25,7 @@ std::string Front::checkInvariants() const {
     const int maxLevel = hierarchy.maxLevel();
     const std::span<const FrontEntry> front = state.entries;
     std::array<std::size_t, morton::kMaxLevel + 1> placeholdersSeen{};
+    std::array<std::size_t, morton::kMaxLevel + 1> entriesPerLevel{};
     std::uint64_t coveredEnd = 0, visiblePoints = 0;
     std::size_t visibleNodes = 0, placeholders = 0;
     morton::Code previousSpan = 0;
@@ -39,6 +40,7 @@ std::string Front::checkInvariants() const {
         }
         previousSpan = span;
         const int level = entry.level();
+        ++entriesPerLevel[static_cast<std::size_t>(level)];
         std::uint64_t coveredBegin = 0, coveredCount = 0;
         if (entry.placeholder) {
             ++placeholders;
@@ -106,6 +108,9 @@ std::string Front::checkInvariants() const {
     }
     if (visibleNodes != state.visibleNodes || visiblePoints != state.visiblePoints) {
         return "visible node or point count out of step";
+    }
+    if (entriesPerLevel != state.levelCounts) {
+        return "entries per level out of step";
     }
     return {};
 }
