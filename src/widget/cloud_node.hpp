@@ -3,6 +3,7 @@
 // and the points or surface-splat passes.
 #pragma once
 
+#include "first_draw_tracker.hpp"
 #include "front.hpp"
 #include "node_buffer_cache.hpp"
 #include "scene_node.hpp"
@@ -39,6 +40,9 @@ public:
 
     // The front of the last frame (empty without a hierarchy).
     const Front* front() const { return m_front.get(); }
+    // Leaves first drawn since the last call and their publish -> drawn delays (all the
+    // render() calls of one frame: a screenshot renders twice).
+    FirstDrawTracker::Delays takeFirstDraws() { return m_firstDraws.take(); }
 
     void initializeGL(QOpenGLExtraFunctions& gl) override;
     void render(RenderContext& context) override;
@@ -64,6 +68,7 @@ private:
     void drawPreview(RenderContext& context);
     void drawPoints(RenderContext& context);
     void drawSplats(RenderContext& context);
+    void recordFirstDraws();
     int effectiveColorMode(const RenderSettings& settings) const;
 
     std::shared_ptr<const Hierarchy> m_hierarchy;
@@ -71,6 +76,8 @@ private:
     NodeBufferCache m_cache;
     std::vector<PointVertex> m_scratch;
     std::vector<DrawItem> m_drawList;
+    FirstDrawTracker m_firstDraws;
+    std::vector<FirstDrawTracker::CoveredRange> m_drawnRanges;
     std::uint64_t m_frame = 0;
     bool m_hierarchyChanged = false;
 
