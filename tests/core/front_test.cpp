@@ -5,11 +5,14 @@
 #include "front.hpp"
 #include "front_projection.hpp"
 #include "hierarchy_test_support.hpp"
+#include "omh_reader.hpp"
+#include "omh_writer.hpp"
+#include "test_files.hpp"
 
 #include <atomic>
-#include <cstdio>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <gtest/gtest.h>
 #include <random>
 #include <thread>
@@ -139,6 +142,30 @@ TEST(Front, EntersACompleteHierarchyFromTheRootAndReachesEveryLeaf) {
     EXPECT_EQ(front.entries()[0].code, morton::kRoot);
     expectEntriesPerLevelMatch(front);
     EXPECT_EQ(front.entriesPerLevel()[0], 1u);
+}
+
+// A hierarchy loaded from a .omh file (its nodes hold their own points, CloudOrder::NodeOrder,
+// not their subtree's input range): the front enters it from the root, branches to every leaf
+// and back, and its invariants hold all the way (the debug preset checks them every frame).
+TEST(Front, WalksALoadedHierarchyWithItsInvariants) {
+    const auto cloud = makeCloud(Shape::Random, 20000, 5);
+    const auto build = buildSynthetic(cloud, frontBuildOptions(5));
+    test::TempDir dir;
+    const std::string path = dir.file("front.omh");
+    writeOmh(path, build.builder->hierarchy(),
+             omhBuildInfo(build.builder->options(), build.builder->statistics()));
+    OmhReader reader(path);
+    const auto loaded = reader.hierarchy();
+    reader.load();
+    ASSERT_EQ(loaded->cloud().order(), CloudOrder::NodeOrder);
+    Front front(loaded);
+    settle(front, orthographic(1e9), unlimited(0.0));
+    EXPECT_EQ(front.entries().size(), countLeaves(*loaded));
+    EXPECT_EQ(front.checkInvariants(), "");
+    expectEntriesPerLevelMatch(front);
+    settle(front, orthographic(1e-3), unlimited(1.0));
+    ASSERT_EQ(front.entries().size(), 1u);
+    EXPECT_EQ(front.checkInvariants(), "");
 }
 
 // Orthographic: a node's size depends only on its level, so the threshold can be put exactly
