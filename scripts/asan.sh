@@ -3,9 +3,10 @@
 # of the core, the viewer and the application takes a long time on CI). Builds the `asan`
 # preset (ASan + UBSan, invariant checkers on) for the tests of cancelling and closing while a
 # build runs, and runs them under Xvfb with leak detection: tst_builderservice (cancel, also
-# during a file's bounds pre-pass; destruction mid-build) and tst_mainwindowGL (close
-# mid-build, open, rebuild, save, errors). Any leak or memory error fails the job; the
-# suppressions in scripts/lsan.supp cover third-party libraries only.
+# during a file's bounds pre-pass; destruction mid-build), tst_mainwindowGL (close mid-build,
+# open, rebuild, save, errors), and the hierarchy tree's tests, which read a hierarchy while a
+# builder grows it (tst_hierarchymodel, tst_cutpanel). Any leak or memory error fails the job;
+# the suppressions in scripts/lsan.supp cover third-party libraries only.
 # Extra arguments replace the default test list, e.g. ./scripts/asan.sh tst_builderservice.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,7 +14,7 @@ source scripts/common.sh
 omicron_install_packages
 
 tests=("$@")
-[ "${#tests[@]}" -eq 0 ] && tests=(tst_builderservice tst_mainwindowGL)
+[ "${#tests[@]}" -eq 0 ] && tests=(tst_builderservice tst_mainwindowGL tst_hierarchymodel tst_cutpanel)
 
 cmake --preset asan >/dev/null
 cmake --build --preset asan --target "${tests[@]}"

@@ -1,9 +1,9 @@
 // CutPanel: the cut progress dock (form ui/cutpanel.ui): progress bars for input read (or the
 // bounds pre-pass of a PLY/XYZ file while it is opened), sorted, inserted and where the cut's
-// delimiter m_C stands in the code space of the deepest level; and two tabs: the per-level
-// table (LevelModel, with the view's front nodes per level) and the tree of the hierarchy's
-// settled top (HierarchyModel) with the selected node's details. Selecting a node emits
-// nodeSelected (the window highlights its cell in the view).
+// delimiter m_C stands in the code space of the deepest level; and, one above the other (a
+// splitter), the per-level table (LevelModel, with the view's front nodes per level) and the
+// tree of the hierarchy's settled top (HierarchyModel) with the selected node's details.
+// Selecting a node emits nodeSelected (the window highlights its cell in the view).
 #pragma once
 
 #include "build_pipeline.hpp"

@@ -82,7 +82,6 @@ void HierarchyModel::setHierarchy(std::shared_ptr<const Hierarchy> hierarchy) {
         const QScopedValueRollback<bool> changing(m_changing, true);
         beginResetModel();
         m_hierarchy = std::move(hierarchy);
-        m_epoch = ~std::uint64_t{0};
         m_settled.fill(0);
         m_topFirst.fill(0);
         for (auto& rows : m_top) {
@@ -137,7 +136,6 @@ void HierarchyModel::refresh() {
     // The cut first, then the counts (shallow to deep): every node the cut says is settled is
     // below its level's count, and every published parent's children are below theirs.
     const PublishedCut cut = hierarchy.publishedCut();
-    m_epoch = cut.epoch;
     const int maxLevel = hierarchy.maxLevel();
     std::array<std::size_t, kLevels> counts{};
     for (int level = 0; level <= maxLevel; ++level) {
@@ -313,19 +311,17 @@ bool HierarchyModel::canFetchMore(const QModelIndex& parent) const {
     if (const Item* row = item(parent)) {
         return !row->fetched && !row->waitingForChildren && octreeNode(*row).childCount > 0;
     }
-    // The top level: whatever the builder published since the last refresh.
-    return m_hierarchy->publishedCut().epoch != m_epoch;
+    // The top level changes only in refresh(): it also removes rows (those whose parent
+    // settled), and views call fetchMore() in the middle of their own work (a layout, a
+    // scrollTo) expecting rows to be added at most.
+    return false;
 }
 
 void HierarchyModel::fetchMore(const QModelIndex& parent) {
     if (!canFetchMore(parent)) {
         return;
     }
-    if (Item* row = item(parent)) {
-        fetchChildren(*row, parent);
-    } else {
-        refresh();
-    }
+    fetchChildren(*item(parent), parent);
 }
 
 void HierarchyModel::fetchChildren(Item& row, const QModelIndex& index) {

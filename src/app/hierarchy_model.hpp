@@ -1,4 +1,4 @@
-// HierarchyModel: the tree of the hierarchy's settled top, for the cut panel's Hierarchy tab.
+// HierarchyModel: the tree of the hierarchy's settled top, for the cut panel's Hierarchy box.
 //
 // Only settled nodes are shown (Hierarchy::isSettled: published, and neither a root of the
 // oblique cut nor a child of one, so their place in the tree never changes). The top-level
@@ -9,6 +9,8 @@
 // at the end of a level's group and removes rows from its start, when their parent settles
 // (they reappear under it). Children are fetched lazily when a row is expanded
 // (canFetchMore/fetchMore); a node never changes once published, so fetched rows stay valid.
+// The top level changes only in refresh(), never in fetchMore(): views fetch in the middle of
+// a layout or a scrollTo and expect rows to be added there, not removed.
 // The hierarchy is read with acquire loads only (its published node counts and the cut), on
 // the GUI thread, while the builder threads append.
 #pragma once
@@ -90,7 +92,6 @@ private:
     void forgetWaiting(const Item& removedTop);
 
     std::shared_ptr<const Hierarchy> m_hierarchy;
-    std::uint64_t m_epoch = ~std::uint64_t{0}; // the cut's epoch at the last refresh
     // Per level: the settled prefix seen so far, and the top-level rows (node indices
     // [m_topFirst, m_topFirst + m_top.size())).
     std::array<std::size_t, kLevels> m_settled{};

@@ -408,7 +408,10 @@ void MainWindow::dropEvent(QDropEvent* event) {
 void MainWindow::loadSettings() {
     QSettings settings;
     restoreGeometry(settings.value("window/geometry").toByteArray());
-    restoreState(settings.value("window/state").toByteArray());
+    if (!restoreState(settings.value("window/state").toByteArray())) {
+        // First start: room for the cut panel's level table (eight columns) and its tree.
+        resizeDocks({findChild<QDockWidget*>(QStringLiteral("cutDock"))}, {460}, Qt::Horizontal);
+    }
     m_recentFiles = settings.value("recentFiles").toStringList();
     while (m_recentFiles.size() > kMaxRecentFiles) {
         m_recentFiles.removeLast();

@@ -1,4 +1,4 @@
-// CutPanel: the Hierarchy tab's tree and details (selecting a node shows its code, level, cell
+// CutPanel: the Hierarchy box's tree and details (selecting a node shows its code, level, cell
 // in source units, points held and covered, children, and emits nodeSelected for the view's
 // highlight; a new hierarchy clears it), a selection that survives its row moving under a
 // parent that settles while a build runs, and the read bar during a bounds pre-pass.

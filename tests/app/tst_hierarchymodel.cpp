@@ -210,7 +210,7 @@ void TestHierarchyModel::completeHierarchyIsRootedAndHoldsEveryNode() {
     tester.reset();
     QCOMPARE(expandAll(model), totalNodes(*hierarchy));
     checkRows(model);
-    QVERIFY(!model.canFetchMore({})); // nothing new published
+    QVERIFY(!model.canFetchMore({})); // the top level changes in refresh() only
 }
 
 void TestHierarchyModel::newHierarchyResetsTheModel() {

@@ -226,9 +226,9 @@ void TestMainWindowGL::closingMidBuildReturnsPromptly() {
     QVERIFY(hierarchy.expired());
 }
 
-// The Hierarchy tab: selecting a node shows its details and draws its cell in the view (the
-// widget's highlight, and magenta pixels in its frame); clearing the selection removes it.
-// The same build feeds the insertion delay chart its leaf -> drawn series.
+// The cut panel's Hierarchy box: selecting a node shows its details and draws its cell in the view
+// (the widget's highlight, and magenta pixels in its frame); clearing the selection removes it. The
+// same build feeds the insertion delay chart its leaf -> drawn series.
 void TestMainWindowGL::hierarchyTreeSelectionHighlightsTheNodeInTheView() {
     MainWindow window;
     window.resize(1400, 900);
