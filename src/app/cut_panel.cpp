@@ -35,8 +35,8 @@ CutPanel::CutPanel(QWidget* parent)
     m_ui->hierarchyTree->setModel(m_hierarchy);
     m_ui->hierarchyTree->header()->setStretchLastSection(false);
     m_ui->hierarchyTree->header()->setSectionResizeMode(QHeaderView::ResizeToContents);
-    m_ui->panelSplitter->setStretchFactor(0, 2);
-    m_ui->panelSplitter->setStretchFactor(1, 3);
+    // Room for a depth-9 table; the tree takes the rest.
+    m_ui->panelSplitter->setSizes({330, 400});
     m_ui->hierarchySplitter->setStretchFactor(0, 3);
     m_ui->hierarchySplitter->setStretchFactor(1, 1);
     connect(m_ui->hierarchyTree->selectionModel(), &QItemSelectionModel::currentChanged, this,

@@ -75,7 +75,7 @@ QVariant LevelModel::headerData(int section, Qt::Orientation orientation, int ro
     }
     static const char* const titles[ColumnCount] = {
         QT_TR_NOOP("Level"),       QT_TR_NOOP("Roots in L_C"), QT_TR_NOOP("Nodes"),
-        QT_TR_NOOP("Leaves"),      QT_TR_NOOP("Points"),       QT_TR_NOOP("Placeholders pending"),
+        QT_TR_NOOP("Leaves"),      QT_TR_NOOP("Points"),       QT_TR_NOOP("Pending"),
         QT_TR_NOOP("Substituted"), QT_TR_NOOP("Front nodes")};
     static const char* const tips[ColumnCount] = {
         QT_TR_NOOP("Octree level (0 = root)"),

@@ -99,6 +99,9 @@ void MainWindow::createDocks() {
         m_ui->menuPanels->addAction(toggle);
         return widget;
     };
+    // The cut panel (progress, level table, hierarchy tree) runs the full height on the right.
+    setCorner(Qt::BottomRightCorner, Qt::RightDockWidgetArea);
+    setCorner(Qt::TopRightCorner, Qt::RightDockWidgetArea);
     m_buildPanel = new BuildPanel(this);
     m_cutPanel = new CutPanel(this);
     m_chartsPanel = new ChartsPanel(this);
@@ -410,7 +413,7 @@ void MainWindow::loadSettings() {
     restoreGeometry(settings.value("window/geometry").toByteArray());
     if (!restoreState(settings.value("window/state").toByteArray())) {
         // First start: room for the cut panel's level table (eight columns) and its tree.
-        resizeDocks({findChild<QDockWidget*>(QStringLiteral("cutDock"))}, {460}, Qt::Horizontal);
+        resizeDocks({findChild<QDockWidget*>(QStringLiteral("cutDock"))}, {590}, Qt::Horizontal);
     }
     m_recentFiles = settings.value("recentFiles").toStringList();
     while (m_recentFiles.size() > kMaxRecentFiles) {
