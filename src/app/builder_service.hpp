@@ -52,8 +52,14 @@ public:
     void openHierarchy(const QString& path);
     bool saveHierarchy(const QString& path);
 
-    // Stops the running job (no-op when idle); a pending request is dropped too.
+    // Stops the running job (no-op when idle), also during the bounds pre-pass of a PLY or
+    // XYZ file (the kept cloud and hierarchy then stay); a pending request is dropped too.
     void cancel();
+    // Called on the worker thread as the bounds pre-pass of a file being opened advances
+    // (progressChanged carries the same numbers at 10 Hz). Set it while no job runs.
+    void setPrePassObserver(BuildPipeline::PrePassObserver observer) {
+        m_pipeline->setPrePassObserver(std::move(observer));
+    }
     // Cancels and joins the worker (blocks only for the worker's next cancellation check).
     void shutdown();
 

@@ -4,6 +4,8 @@
 #include "time_series_chart.hpp"
 
 #include <QGridLayout>
+#include <QLineSeries>
+#include <algorithm>
 
 namespace omicron {
 
@@ -21,7 +23,12 @@ ChartsPanel::ChartsPanel(QWidget* parent) : QWidget(parent) {
     };
     m_inserted = add(tr("Inserted points"), tr("points"),
                      {tr("inserted"), tr("sorted"), tr("ideal (constant rate)")});
-    m_delay = add(tr("Insertion delay"), tr("s"), {tr("sorted -> inserted")});
+    m_delay = add(tr("Insertion delay"), tr("ms"),
+                  {tr("leaf -> drawn median"), tr("leaf -> drawn max"), tr("sorted -> inserted")});
+    // Leaves are first drawn in bursts while a build runs: mark every sample, a lone one too.
+    for (int line = 0; line < m_delay->lineCount(); ++line) {
+        m_delay->line(line)->setPointsVisible(true);
+    }
     m_front = add(tr("Front size"), tr("nodes"), {tr("front nodes")});
     m_cpu = add(tr("CPU per frame"), tr("ms"), {tr("total"), tr("front evaluation")});
     m_fpsChart = add(tr("Frame rate"), tr("fps"), {tr("fps")});
@@ -29,9 +36,14 @@ ChartsPanel::ChartsPanel(QWidget* parent) : QWidget(parent) {
     m_inserted->setToolTip(m_inserted->toolTip() +
                            tr("\nThe ideal line is the straight line to the final point count: "
                               "insertion at a constant rate."));
-    m_delay->setToolTip(m_delay->toolTip() +
-                        tr("\nHow long ago the points now inserted into the hierarchy had been "
-                           "sorted: the wait between the sorter and the builder."));
+    m_delay->setToolTip(
+        m_delay->toolTip() +
+        tr("\nLeaf published -> drawn: the paper's front insertion delay, from the builder "
+           "publishing a leaf to the first frame of the view that draws its points (its own "
+           "node, or an ancestor standing for it); median and maximum over the leaves first "
+           "drawn since the previous sample.\nSorted -> inserted: how long ago the points now "
+           "inserted into the hierarchy had been sorted, the wait between the sorter and the "
+           "builder."));
     m_timer.setInterval(kSampleIntervalMs);
     connect(&m_timer, &QTimer::timeout, this, &ChartsPanel::sample);
     m_clock.start();
@@ -54,6 +66,8 @@ void ChartsPanel::startBuild() {
     m_clock.restart();
     m_progress = {};
     m_sortedHistory.clear();
+    m_leafDelayMedians.clear();
+    m_leafDelayMaxMs = 0.0;
     m_building = true;
 }
 
@@ -65,12 +79,39 @@ void ChartsPanel::setHierarchyBytes(std::size_t bytes) {
     m_hierarchyBytes = bytes;
 }
 
-void ChartsPanel::setFrame(double frameMs, double frontMs, double fps, std::size_t frontNodes) {
+void ChartsPanel::setFrame(const FrameStats& stats) {
     m_haveFrame = true;
-    m_frameMs = frameMs;
-    m_frontMs = frontMs;
-    m_lastFps = fps;
-    m_frontNodes = frontNodes;
+    m_frameMs = stats.frameMs;
+    m_frontMs = stats.frontMs;
+    m_lastFps = stats.fps;
+    m_frontNodes = stats.frontNodes;
+    if (stats.leavesFirstDrawn > 0) {
+        m_leafDelayMedians.emplace_back(stats.leafDrawDelayMedianMs, stats.leavesFirstDrawn);
+        m_leafDelayMaxMs = std::max(m_leafDelayMaxMs, stats.leafDrawDelayMaxMs);
+    }
+}
+
+bool ChartsPanel::takeLeafDelays(double& medianMs, double& maxMs) {
+    if (m_leafDelayMedians.empty()) {
+        return false;
+    }
+    std::sort(m_leafDelayMedians.begin(), m_leafDelayMedians.end());
+    std::size_t total = 0;
+    for (const auto& [median, leaves] : m_leafDelayMedians) {
+        total += leaves;
+    }
+    std::size_t seen = 0;
+    for (const auto& [median, leaves] : m_leafDelayMedians) {
+        seen += leaves;
+        if (2 * seen >= total) {
+            medianMs = median;
+            break;
+        }
+    }
+    maxMs = m_leafDelayMaxMs;
+    m_leafDelayMedians.clear();
+    m_leafDelayMaxMs = 0.0;
+    return true;
 }
 
 double ChartsPanel::insertionDelaySeconds(double now) const {
@@ -94,7 +135,7 @@ void ChartsPanel::sample() {
         if (m_progress.pointsSorted > 0) {
             m_sortedHistory.emplace_back(now, m_progress.pointsSorted);
             if (m_progress.pointsInserted > 0) {
-                m_delay->append(0, now, insertionDelaySeconds(now));
+                m_delay->append(2, now, 1000.0 * insertionDelaySeconds(now));
             }
         }
         const bool ended = m_progress.phase == BuildPhase::Complete ||
@@ -103,6 +144,11 @@ void ChartsPanel::sample() {
         if (ended && m_progress.generation != 0) {
             m_building = false; // the build charts keep their last state
         }
+    }
+    double medianMs = 0.0, maxMs = 0.0;
+    if (takeLeafDelays(medianMs, maxMs)) {
+        m_delay->append(0, now, medianMs);
+        m_delay->append(1, now, maxMs);
     }
     if (m_haveFrame) {
         m_front->append(0, now, static_cast<double>(m_frontNodes));

@@ -1,10 +1,13 @@
 // ChartsPanel: the live charts dock. Samples at most 10 times a second (its own timer) what
 // the builder service and the view last reported: points inserted over time against the ideal
-// constant-rate line, the insertion delay, the front size, CPU milliseconds per frame (front
-// evaluation and total), frames per second, and resident memory.
+// constant-rate line, the insertion delays (the paper's front insertion delay, leaf published
+// -> first drawn, from the view's frames; and sorted -> inserted, from the build's progress),
+// the front size, CPU milliseconds per frame (front evaluation and total), frames per second,
+// and resident memory.
 #pragma once
 
 #include "build_pipeline.hpp"
+#include "render_settings.hpp"
 
 #include <QElapsedTimer>
 #include <QTimer>
@@ -31,8 +34,9 @@ public slots:
     void startBuild();
     void setProgress(const omicron::PipelineProgress& progress);
     void setHierarchyBytes(std::size_t bytes);
-    // The view's last frame (CPU ms for the whole frame and the front, fps, front nodes).
-    void setFrame(double frameMs, double frontMs, double fps, std::size_t frontNodes);
+    // A frame of the view: CPU ms for the whole frame and the front, fps, front nodes, and
+    // the leaves it drew first (their delays are gathered until the next sample).
+    void setFrame(const omicron::FrameStats& stats);
 
 signals:
     void exportFailed(const QString& path, const QString& message);
@@ -40,6 +44,9 @@ signals:
 private:
     void sample();
     double insertionDelaySeconds(double now) const;
+    // Median (over the frames' medians, weighted by their leaf counts) and maximum of the
+    // leaf -> drawn delays of the frames since the last sample; false when none drew a leaf.
+    bool takeLeafDelays(double& medianMs, double& maxMs);
 
     std::vector<TimeSeriesChart*> m_charts;
     TimeSeriesChart* m_inserted = nullptr;
@@ -59,6 +66,9 @@ private:
     double m_frontMs = 0.0;
     double m_lastFps = 0.0;
     std::size_t m_frontNodes = 0;
+    // (frame median ms, leaves first drawn) of the frames since the last sample, and their max.
+    std::vector<std::pair<double, std::size_t>> m_leafDelayMedians;
+    double m_leafDelayMaxMs = 0.0;
     // (seconds, points sorted) history, to tell how long ago the inserted count was sorted.
     std::deque<std::pair<double, std::uint64_t>> m_sortedHistory;
 };

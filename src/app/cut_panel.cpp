@@ -1,10 +1,13 @@
 #include "cut_panel.hpp"
 
+#include "hierarchy_model.hpp"
 #include "level_model.hpp"
 #include "ui_cutpanel.h"
 
 #include <QHeaderView>
+#include <QItemSelectionModel>
 #include <QLocale>
+#include <QTreeView>
 
 namespace omicron {
 
@@ -14,7 +17,7 @@ int permille(std::uint64_t part, std::uint64_t whole) {
     return whole == 0 ? 0 : static_cast<int>(std::min<std::uint64_t>(1000, part * 1000 / whole));
 }
 
-QString barText(std::uint64_t part, std::uint64_t whole) {
+QString countText(std::uint64_t part, std::uint64_t whole) {
     const QLocale locale;
     return QStringLiteral("%1 / %2").arg(locale.toString(quint64(part)),
                                          locale.toString(quint64(whole)));
@@ -23,15 +26,109 @@ QString barText(std::uint64_t part, std::uint64_t whole) {
 } // namespace
 
 CutPanel::CutPanel(QWidget* parent)
-    : QWidget(parent), m_ui(std::make_unique<Ui::CutPanel>()), m_levels(new LevelModel(this)) {
+    : QWidget(parent), m_ui(std::make_unique<Ui::CutPanel>()), m_levels(new LevelModel(this)),
+      m_hierarchy(new HierarchyModel(this)) {
     m_ui->setupUi(this);
     m_ui->levelTable->setModel(m_levels);
     m_ui->levelTable->verticalHeader()->hide();
     m_ui->levelTable->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+    m_ui->hierarchyTree->setModel(m_hierarchy);
+    m_ui->hierarchyTree->header()->setStretchLastSection(false);
+    m_ui->hierarchyTree->header()->setSectionResizeMode(QHeaderView::ResizeToContents);
+    // Room for a depth-9 table; the tree takes the rest.
+    m_ui->panelSplitter->setSizes({330, 400});
+    m_ui->hierarchySplitter->setStretchFactor(0, 3);
+    m_ui->hierarchySplitter->setStretchFactor(1, 1);
+    connect(m_ui->hierarchyTree->selectionModel(), &QItemSelectionModel::currentChanged, this,
+            [this](const QModelIndex& current) { onCurrentNodeChanged(current); });
     clear();
 }
 
 CutPanel::~CutPanel() = default;
+
+QTreeView* CutPanel::hierarchyTree() const {
+    return m_ui->hierarchyTree;
+}
+
+QString CutPanel::nodeDetails() const {
+    return m_ui->nodeDetails->text();
+}
+
+void CutPanel::setFrontNodes(std::span<const std::size_t> perLevel) {
+    m_levels->setFrontNodes(perLevel);
+}
+
+void CutPanel::setHierarchy(std::shared_ptr<const Hierarchy> hierarchy) {
+    if (hierarchy == m_hierarchy->hierarchy()) {
+        return;
+    }
+    m_refreshing = true;
+    m_hierarchy->setHierarchy(std::move(hierarchy));
+    m_refreshing = false;
+    if (m_selected) {
+        m_selected.reset();
+        showNoSelection();
+        emit nodeSelectionCleared();
+    }
+}
+
+void CutPanel::refreshHierarchy() {
+    m_refreshing = true;
+    m_hierarchy->refresh();
+    m_refreshing = false;
+    if (!m_selected) {
+        return;
+    }
+    const auto current = m_hierarchy->node(m_ui->hierarchyTree->selectionModel()->currentIndex());
+    if (!current ||
+        m_hierarchy->hierarchy()->node(current->level, current->index).code != *m_selected) {
+        // The selected row went to the top of its parent, which settled: select it there.
+        const morton::Code code = *m_selected;
+        if (!selectNode(code)) {
+            m_selected.reset();
+            showNoSelection();
+            emit nodeSelectionCleared();
+        }
+    }
+}
+
+bool CutPanel::selectNode(morton::Code code) {
+    const QModelIndex index = m_hierarchy->indexOfNode(code);
+    if (!index.isValid()) {
+        return false;
+    }
+    m_ui->hierarchyTree->scrollTo(index); // expands the rows above it
+    m_ui->hierarchyTree->selectionModel()->setCurrentIndex(
+        index, QItemSelectionModel::ClearAndSelect | QItemSelectionModel::Rows);
+    return true;
+}
+
+void CutPanel::onCurrentNodeChanged(const QModelIndex& current) {
+    if (m_refreshing) {
+        return; // refreshHierarchy() puts the selection back where the user left it
+    }
+    const auto node = m_hierarchy->node(current);
+    if (!node) {
+        if (m_selected) {
+            m_selected.reset();
+            showNoSelection();
+            emit nodeSelectionCleared();
+        }
+        return;
+    }
+    const Hierarchy& hierarchy = *m_hierarchy->hierarchy();
+    const morton::Code code = hierarchy.node(node->level, node->index).code;
+    m_ui->nodeDetails->setText(describeNode(hierarchy, node->level, node->index));
+    if (m_selected != code) {
+        m_selected = code;
+        emit nodeSelected(node->level, code);
+    }
+}
+
+void CutPanel::showNoSelection() {
+    m_ui->nodeDetails->setText(
+        tr("Select a node to see its details; its cell is drawn in the view."));
+}
 
 int CutPanel::sweptPermille(morton::Code delimiter, int maxLevel) {
     if (delimiter == 0 || maxLevel < 1) {
@@ -48,6 +145,19 @@ int CutPanel::sweptPermille(morton::Code delimiter, int maxLevel) {
     return static_cast<int>(std::min<long double>(1000.0L, swept * 1000.0L));
 }
 
+QString CutPanel::barText(int bar) const {
+    switch (bar) {
+    case 0:
+        return m_ui->readBar->format();
+    case 1:
+        return m_ui->sortedBar->format();
+    case 2:
+        return m_ui->insertedBar->format();
+    default:
+        return m_ui->cutBar->format();
+    }
+}
+
 int CutPanel::barValue(int bar) const {
     switch (bar) {
     case 0:
@@ -62,14 +172,24 @@ int CutPanel::barValue(int bar) const {
 }
 
 void CutPanel::setProgress(const PipelineProgress& progress) {
-    m_ui->phaseLabel->setText(QString::fromLatin1(toString(progress.phase)));
+    m_ui->phaseLabel->setText(progress.phase == BuildPhase::Opening && progress.bytesToScan > 0
+                                  ? tr("opening: scanning the file for its bounds")
+                                  : QString::fromLatin1(toString(progress.phase)));
     const std::uint64_t total = progress.pointsTotal;
-    m_ui->readBar->setValue(permille(progress.pointsRead, total));
-    m_ui->readBar->setFormat(barText(progress.pointsRead, total));
+    if (progress.phase == BuildPhase::Opening && progress.bytesToScan > 0) {
+        // PLY and XYZ files are read once for their bounds before any point streams.
+        m_ui->readBar->setValue(permille(progress.bytesScanned, progress.bytesToScan));
+        m_ui->readBar->setFormat(tr("scanning bounds: %1 / %2 MiB")
+                                     .arg(progress.bytesScanned / 1048576.0, 0, 'f', 1)
+                                     .arg(progress.bytesToScan / 1048576.0, 0, 'f', 1));
+    } else {
+        m_ui->readBar->setValue(permille(progress.pointsRead, total));
+        m_ui->readBar->setFormat(countText(progress.pointsRead, total));
+    }
     m_ui->sortedBar->setValue(permille(progress.pointsSorted, total));
-    m_ui->sortedBar->setFormat(barText(progress.pointsSorted, total));
+    m_ui->sortedBar->setFormat(countText(progress.pointsSorted, total));
     m_ui->insertedBar->setValue(permille(progress.pointsInserted, total));
-    m_ui->insertedBar->setFormat(barText(progress.pointsInserted, total));
+    m_ui->insertedBar->setFormat(countText(progress.pointsInserted, total));
     const int swept = sweptPermille(progress.cutDelimiter, progress.maxLevel);
     m_ui->cutBar->setValue(swept);
     m_ui->cutBar->setFormat(progress.cutDelimiter == 0 ? tr("no fix pass yet")
@@ -80,6 +200,7 @@ void CutPanel::setProgress(const PipelineProgress& progress) {
 
 void CutPanel::setStatistics(const BuildStatistics& statistics) {
     m_levels->setStatistics(statistics);
+    refreshHierarchy();
     const QLocale locale;
     m_ui->summaryLabel->setText(
         tr("%1 nodes · %2 fix passes (%3 restarted) · %4 duplicate parents merged · "

@@ -41,6 +41,10 @@ quint64 LevelModel::value(int level, Column column) const {
         return row.placeholdersPending;
     case PlaceholdersSubstituted:
         return row.placeholdersSubstituted;
+    case FrontNodes:
+        return static_cast<std::size_t>(level) < m_frontNodes.size()
+                   ? m_frontNodes[static_cast<std::size_t>(level)]
+                   : 0;
     case ColumnCount:
         break;
     }
@@ -70,9 +74,9 @@ QVariant LevelModel::headerData(int section, Qt::Orientation orientation, int ro
         return {};
     }
     static const char* const titles[ColumnCount] = {
-        QT_TR_NOOP("Level"),      QT_TR_NOOP("Roots in L_C"), QT_TR_NOOP("Nodes"),
-        QT_TR_NOOP("Leaves"),     QT_TR_NOOP("Points"),       QT_TR_NOOP("Placeholders pending"),
-        QT_TR_NOOP("Substituted")};
+        QT_TR_NOOP("Level"),       QT_TR_NOOP("Roots in L_C"), QT_TR_NOOP("Nodes"),
+        QT_TR_NOOP("Leaves"),      QT_TR_NOOP("Points"),       QT_TR_NOOP("Pending"),
+        QT_TR_NOOP("Substituted"), QT_TR_NOOP("Front nodes")};
     static const char* const tips[ColumnCount] = {
         QT_TR_NOOP("Octree level (0 = root)"),
         QT_TR_NOOP("Subtree roots in this level's list of the oblique cut (placeholders "
@@ -81,7 +85,9 @@ QVariant LevelModel::headerData(int section, Qt::Orientation orientation, int ro
         QT_TR_NOOP("Of those, leaves (at the deepest level, or a placeholder's leaf)"),
         QT_TR_NOOP("Points the level's nodes hold (parents hold a sample of their children)"),
         QT_TR_NOOP("Placeholders of collapsed leaves still rising through this level's list"),
-        QT_TR_NOOP("Placeholders that became leaves at this level")};
+        QT_TR_NOOP("Placeholders that became leaves at this level"),
+        QT_TR_NOOP("Nodes of the view's render front at this level in the last frame "
+                   "(placeholders of leaves not yet substituted included)")};
     if (role == Qt::DisplayRole) {
         return tr(titles[section]);
     }
@@ -108,7 +114,25 @@ void LevelModel::setStatistics(const BuildStatistics& statistics) {
     }
 }
 
+void LevelModel::setFrontNodes(std::span<const std::size_t> perLevel) {
+    if (perLevel.size() > m_frontNodes.size()) {
+        m_frontNodes.resize(perLevel.size(), 0);
+    }
+    for (std::size_t level = 0; level < m_frontNodes.size(); ++level) {
+        const quint64 count = level < perLevel.size() ? perLevel[level] : 0;
+        if (m_frontNodes[level] == count) {
+            continue;
+        }
+        m_frontNodes[level] = count;
+        if (level < m_levels.size()) {
+            const QModelIndex cell = index(static_cast<int>(level), FrontNodes);
+            emit dataChanged(cell, cell, {Qt::DisplayRole, Qt::EditRole});
+        }
+    }
+}
+
 void LevelModel::clear() {
+    m_frontNodes.clear();
     if (m_levels.empty()) {
         return;
     }

@@ -99,6 +99,9 @@ void MainWindow::createDocks() {
         m_ui->menuPanels->addAction(toggle);
         return widget;
     };
+    // The cut panel (progress, level table, hierarchy tree) runs the full height on the right.
+    setCorner(Qt::BottomRightCorner, Qt::RightDockWidgetArea);
+    setCorner(Qt::TopRightCorner, Qt::RightDockWidgetArea);
     m_buildPanel = new BuildPanel(this);
     m_cutPanel = new CutPanel(this);
     m_chartsPanel = new ChartsPanel(this);
@@ -167,6 +170,10 @@ void MainWindow::connectActions() {
     connect(m_buildPanel, &BuildPanel::viewParametersChanged, this,
             &MainWindow::applyViewParameters);
     connect(m_chartsPanel, &ChartsPanel::exportFailed, this, &MainWindow::showError);
+    // The node selected in the cut panel's hierarchy tree is drawn as a box in the view.
+    connect(m_cutPanel, &CutPanel::nodeSelected, m_view,
+            [this](int level, quint64 code) { m_view->setHighlightedNode(level, code); });
+    connect(m_cutPanel, &CutPanel::nodeSelectionCleared, m_view, &CloudView::clearHighlightedNode);
 
     auto* renderModes = new QActionGroup(this);
     const std::pair<QAction*, RenderMode> renderModeActions[] = {
@@ -243,7 +250,8 @@ void MainWindow::connectActions() {
     connect(m_ui->actionFlyMode, &QAction::toggled, m_view, &CloudView::setFlyMode);
     connect(m_view, &CloudView::flyModeChanged, m_ui->actionFlyMode, &QAction::setChecked);
     connect(m_view, &CloudView::frameRendered, this, [this](const FrameStats& stats) {
-        m_chartsPanel->setFrame(stats.frameMs, stats.frontMs, stats.fps, stats.frontNodes);
+        m_chartsPanel->setFrame(stats);
+        m_cutPanel->setFrontNodes(stats.frontNodesPerLevel);
         m_pointsDrawn = stats.pointsDrawn;
         m_fps = stats.fps;
     });
@@ -262,12 +270,17 @@ void MainWindow::connectService() {
                 m_progress = progress;
                 m_cutPanel->setProgress(progress);
                 m_chartsPanel->setProgress(progress);
-                // Read, sort and insert each take a third of the bar.
-                const double total = std::max<double>(1.0, double(progress.pointsTotal));
-                m_progressBar->setValue(static_cast<int>(
-                    1000.0 *
-                    (progress.pointsRead + progress.pointsSorted + progress.pointsInserted) /
-                    (3.0 * total)));
+                if (progress.phase == BuildPhase::Opening && progress.bytesToScan > 0) {
+                    m_progressBar->setValue(
+                        static_cast<int>(1000.0 * progress.bytesScanned / progress.bytesToScan));
+                } else {
+                    // Read, sort and insert each take a third of the bar.
+                    const double total = std::max<double>(1.0, double(progress.pointsTotal));
+                    m_progressBar->setValue(static_cast<int>(
+                        1000.0 *
+                        (progress.pointsRead + progress.pointsSorted + progress.pointsInserted) /
+                        (3.0 * total)));
+                }
                 updateStatus();
             });
     connect(m_service, &BuilderService::statisticsChanged, this,
@@ -277,6 +290,7 @@ void MainWindow::connectService() {
             });
     connect(m_service, &BuilderService::hierarchyChanged, this,
             [this](std::shared_ptr<const Hierarchy> hierarchy) {
+                m_cutPanel->setHierarchy(hierarchy);
                 m_view->setHierarchy(std::move(hierarchy));
             });
     connect(m_service, &BuilderService::previewChanged, this,
@@ -285,6 +299,17 @@ void MainWindow::connectService() {
             });
     connect(m_service, &BuilderService::buildFinished, this, [this](const PipelineResult& result) {
         const QLocale locale;
+        const auto kept = m_service->source();
+        if (result.cancelled && kept && kept->path != result.source.path) {
+            // Cancelled before the new file replaced anything (its bounds pre-pass): the view
+            // still shows the previous cloud, so does the title.
+            const QString previous = m_title;
+            m_title = kept->path.empty() ? tr("generated scene")
+                                         : QFileInfo(QString::fromStdString(kept->path)).fileName();
+            setWindowTitle(tr("%1 — omicron").arg(m_title));
+            statusBar()->showMessage(tr("Opening %1 cancelled").arg(previous), 10000);
+            return;
+        }
         statusBar()->showMessage(
             result.cancelled ? tr("Build of %1 cancelled").arg(m_title)
                              : tr("%1: %2 points, %3 nodes in %4 s")
@@ -386,7 +411,10 @@ void MainWindow::dropEvent(QDropEvent* event) {
 void MainWindow::loadSettings() {
     QSettings settings;
     restoreGeometry(settings.value("window/geometry").toByteArray());
-    restoreState(settings.value("window/state").toByteArray());
+    if (!restoreState(settings.value("window/state").toByteArray())) {
+        // First start: room for the cut panel's level table (eight columns) and its tree.
+        resizeDocks({findChild<QDockWidget*>(QStringLiteral("cutDock"))}, {590}, Qt::Horizontal);
+    }
     m_recentFiles = settings.value("recentFiles").toStringList();
     while (m_recentFiles.size() > kMaxRecentFiles) {
         m_recentFiles.removeLast();
@@ -449,7 +477,9 @@ void MainWindow::updateActions() {
 
 void MainWindow::updateStatus() {
     const QLocale locale;
-    m_phaseLabel->setText(QString::fromLatin1(toString(m_progress.phase)));
+    m_phaseLabel->setText(m_progress.phase == BuildPhase::Opening && m_progress.bytesToScan > 0
+                              ? tr("scanning bounds")
+                              : QString::fromLatin1(toString(m_progress.phase)));
     m_pointsLabel->setText(tr("%1 / %2 points")
                                .arg(locale.toString(quint64(m_pointsDrawn)),
                                     locale.toString(quint64(m_progress.pointsTotal))));

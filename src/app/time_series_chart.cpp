@@ -43,7 +43,10 @@ TimeSeriesChart::TimeSeriesChart(const QString& title, const QString& unit,
         series->attachAxis(m_axisY);
         m_lines.push_back(series);
     }
+    // QChartView made a chart of its own, which setChart() only releases: delete it.
+    QChart* const defaultChart = QChartView::chart();
     setChart(chart);
+    delete defaultChart;
     setRenderHint(QPainter::Antialiasing);
     setMinimumSize(220, 160);
     setToolTip(tr("%1. Right-click to export the chart as PNG or its data as CSV.").arg(title));

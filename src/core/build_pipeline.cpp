@@ -176,6 +176,8 @@ PipelineResult BuildPipeline::runHierarchyFile(const std::string& path) {
 
 void BuildPipeline::beginRun(BuildPhase phase) {
     m_pointsRead.store(0);
+    m_bytesScanned.store(0);
+    m_bytesToScan.store(0);
     m_generation.fetch_add(1);
     setPhase(phase);
 }
@@ -212,7 +214,27 @@ PipelineResult BuildPipeline::finishBuild(HierarchyBuilder& builder, PipelineRes
 
 PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOptions& options) {
     beginRun(BuildPhase::Opening);
-    auto reader = openPointCloud(path);
+    OpenOptions openOptions;
+    openOptions.cancel = &m_cancel;
+    openOptions.onPrePassProgress = [&](std::uint64_t scanned, std::uint64_t fileBytes) {
+        m_bytesToScan.store(fileBytes, std::memory_order_relaxed);
+        m_bytesScanned.store(scanned, std::memory_order_relaxed);
+        if (m_prePassObserver) {
+            m_prePassObserver(scanned, fileBytes);
+        }
+    };
+    std::unique_ptr<PointReader> reader;
+    try {
+        reader = openPointCloud(path, openOptions);
+    } catch (const OpenCancelled&) {
+        // Nothing was replaced yet: the previous source, cloud and hierarchy stay.
+        setPhase(BuildPhase::Cancelled);
+        PipelineResult result;
+        result.pipeline = toString(PipelineKind::UnsortedCloud);
+        result.source.path = path;
+        result.cancelled = true;
+        return result;
+    }
     const CloudInfo& info = reader->info();
     SortOptions sortOptions;
     sortOptions.chunks = options.sortChunks;
@@ -399,6 +421,8 @@ PipelineProgress BuildPipeline::progress() const {
     progress.generation = m_generation.load();
     progress.pointsTotal = m_pointsTotal.load();
     progress.pointsRead = m_pointsRead.load(std::memory_order_relaxed);
+    progress.bytesToScan = m_bytesToScan.load(std::memory_order_relaxed);
+    progress.bytesScanned = m_bytesScanned.load(std::memory_order_relaxed);
     std::shared_ptr<HierarchyBuilder> builder;
     std::shared_ptr<const SortedCloud> cloud;
     {

@@ -23,6 +23,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -64,6 +65,10 @@ struct PipelineProgress {
     morton::Code cutDelimiter = 0;    // m_C of the last complete fix pass; 0 before it
     int maxLevel = 0;                 // depth of the current build (for cutDelimiter)
     std::uint64_t generation = 0;     // bumped by every run*() and rebuild()
+    // The bounds pre-pass of a PLY or XYZ file (phase Opening): bytes scanned of the file's
+    // size; both 0 when the source has no pre-pass (LAS, .oms, .omh, the generated scene).
+    std::uint64_t bytesScanned = 0;
+    std::uint64_t bytesToScan = 0;
 };
 
 // What the source is, known once it is opened.
@@ -120,12 +125,21 @@ public:
     // no file is read. Throws std::logic_error when no complete sorted cloud is kept.
     PipelineResult rebuild(const BuildOptions& options);
 
-    // Any thread: stops the current run at the next batch, chunk or fix level. The request
+    // Any thread: stops the current run at the next batch, chunk or fix level (or block of
+    // the bounds pre-pass: the run then returns cancelled with the previous cloud and
+    // hierarchy kept, since it never got to replace them). The request
     // stays until resetCancel(), so a cancel that races with the start of a run (issued
     // before the run's thread got going) still stops it: every later run returns at once,
     // cancelled, until the owner calls resetCancel() before starting the next one.
     void cancel();
     void resetCancel() { m_cancel.store(false); }
+
+    // Called on the run's thread as the bounds pre-pass of a cloud file advances (see
+    // OpenOptions::onPrePassProgress); it may call cancel(). progress() has the same numbers
+    // for pollers. Set it between runs, not during one.
+    using PrePassObserver =
+        std::function<void(std::uint64_t bytesScanned, std::uint64_t fileBytes)>;
+    void setPrePassObserver(PrePassObserver observer) { m_prePassObserver = std::move(observer); }
 
     // ---- Any thread. ----
     PipelineProgress progress() const;
@@ -159,10 +173,13 @@ private:
     void setPhase(BuildPhase phase) { m_phase.store(static_cast<int>(phase)); }
     bool cancelled() const { return m_cancel.load(std::memory_order_relaxed); }
 
+    PrePassObserver m_prePassObserver;
     std::atomic<bool> m_cancel{false};
     std::atomic<int> m_phase{static_cast<int>(BuildPhase::Idle)};
     std::atomic<std::uint64_t> m_pointsTotal{0};
     std::atomic<std::uint64_t> m_pointsRead{0};
+    std::atomic<std::uint64_t> m_bytesScanned{0};
+    std::atomic<std::uint64_t> m_bytesToScan{0};
     std::atomic<std::uint64_t> m_generation{0};
     std::atomic<std::uint64_t> m_sourceReads{0};
     std::atomic<bool> m_running{false};

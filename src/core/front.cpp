@@ -68,6 +68,8 @@ void Front::Impl::takeInsertions(FrontEvaluation& result) {
         if (nodeCounts[0] > 0) {
             mode = Mode::TopDown;
             entries.assign(1, FrontEntry{morton::kRoot, 0, false, false});
+            levelCounts.fill(0);
+            levelCounts[0] = 1;
         }
         return;
     }
@@ -81,6 +83,7 @@ void Front::Impl::takeInsertions(FrontEvaluation& result) {
     for (std::size_t i = insertionsTaken; i < count; ++i) {
         const morton::Code leaf = hierarchy.insertion(i).leafCode;
         entries.push_back(FrontEntry{leaf, static_cast<std::uint32_t>(i), true, false});
+        ++levelCounts[static_cast<std::size_t>(morton::level(leaf))];
         substitution.add(leaf, static_cast<std::uint32_t>(i), evaluations);
     }
     result.placeholdersInserted = count - insertionsTaken;
@@ -177,6 +180,8 @@ bool Front::Impl::sweep(const FrontOptions& options, FrontEvaluation& result) {
                             account(entries[member], -1);
                         }
                         account(parent, +1);
+                        levelCounts[static_cast<std::size_t>(level)] -= end - read;
+                        ++levelCounts[static_cast<std::size_t>(level - 1)];
                         entries[written++] = parent;
                         read = end;
                         ++result.pruned;
@@ -256,6 +261,11 @@ FrontEvaluation Front::evaluate(const FrontCamera& camera, const FrontOptions& o
 std::span<const FrontEntry> Front::entries() const { return m_impl->entries; }
 
 std::size_t Front::placeholderCount() const { return m_impl->placeholders; }
+
+std::span<const std::size_t> Front::entriesPerLevel() const {
+    return std::span<const std::size_t>(m_impl->levelCounts)
+        .first(static_cast<std::size_t>(m_impl->hierarchy.maxLevel()) + 1);
+}
 
 const Hierarchy& Front::hierarchy() const { return m_impl->hierarchy; }
 

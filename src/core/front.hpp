@@ -100,6 +100,9 @@ public:
     // The front in span order (invariant 2.1).
     std::span<const FrontEntry> entries() const;
     std::size_t placeholderCount() const;
+    // Entries of the front at each level 0..maxLevel (placeholders at their leaf's level);
+    // sums to entries().size(). Kept current by every change, so reading it costs nothing.
+    std::span<const std::size_t> entriesPerLevel() const;
 
     const Hierarchy& hierarchy() const;
 

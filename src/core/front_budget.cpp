@@ -222,6 +222,8 @@ void Front::Impl::rebuild(std::vector<Rebuild>& ops, FrontEvaluation& result) {
             }
             account(first, -1);
             const OctreeNode& node = hierarchy.node(first.level(), op.nodeIndex);
+            --levelCounts[static_cast<std::size_t>(first.level())];
+            levelCounts[static_cast<std::size_t>(first.level()) + 1] += node.childCount;
             for (std::uint32_t c = 0; c < node.childCount; ++c) {
                 const std::uint32_t index = node.firstChild + c;
                 const morton::Code code = hierarchy.node(first.level() + 1, index).code;
@@ -248,6 +250,8 @@ void Front::Impl::rebuild(std::vector<Rebuild>& ops, FrontEvaluation& result) {
         const FrontEntry parent{parentCode, op.nodeIndex, false,
                                 intersectsFrustum(frustum, cellBox(parentCode))};
         account(parent, +1);
+        levelCounts[static_cast<std::size_t>(first.level())] -= op.members;
+        ++levelCounts[static_cast<std::size_t>(first.level()) - 1];
         rebuilt.push_back(parent);
         copied = op.position + op.members;
         ++result.pruned;

@@ -109,6 +109,9 @@ struct Front::Impl {
     // Visible entries and the points they hold, kept current with every change.
     std::size_t visibleNodes = 0;
     std::uint64_t visiblePoints = 0;
+    // Entries per level (placeholders included), kept current by every operation that adds,
+    // removes or replaces entries, so a renderer reads them per frame without a walk.
+    std::array<std::size_t, morton::kMaxLevel + 1> levelCounts{};
 
     std::vector<double> delaysSeconds;
     std::vector<std::uint32_t> delaysEvaluations;

@@ -3,6 +3,7 @@
 #include "file_stream.hpp"
 #include "input_error.hpp"
 #include "las_header.hpp"
+#include "pre_pass_monitor.hpp"
 #include "source_normalizer.hpp"
 
 #include <algorithm>
@@ -57,7 +58,7 @@ public:
             m_info.sourceBounds = m_header.declaredBounds;
             m_info.boundsFromHeader = true;
         } else {
-            m_info.sourceBounds = boundsPrePass();
+            m_info.sourceBounds = boundsPrePass(options);
         }
         m_info.cube = CubeTransform::fromBounds(m_info.sourceBounds);
         m_info.formatDetail = describeFormat();
@@ -105,14 +106,22 @@ private:
     }
 
     // Only when the header's bounds are unusable (NaN, min > max): one pass over the records.
-    Bounds boundsPrePass() {
+    Bounds boundsPrePass(const OpenOptions& options) {
         Bounds bounds;
-        forEachBlock([&](const std::uint8_t* records, std::uint64_t count, std::uint64_t) {
+        PrePassMonitor monitor(options, m_stream.path(), m_stream.size());
+        if (!monitor.reached(m_header.pointDataOffset)) {
+            monitor.throwCancelled();
+        }
+        forEachBlock([&](const std::uint8_t* records, std::uint64_t count, std::uint64_t first) {
             for (std::uint64_t i = 0; i < count; ++i) {
                 bounds.extend(sourcePosition(records + i * m_header.recordLength));
             }
-            return true;
+            return monitor.reached(m_header.recordOffset(first + count));
         });
+        if (monitor.cancelled()) {
+            monitor.throwCancelled();
+        }
+        monitor.finished();
         return bounds;
     }
 

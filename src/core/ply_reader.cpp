@@ -6,6 +6,7 @@
 #include "ply_float_records.hpp"
 #include "ply_header.hpp"
 #include "ply_values.hpp"
+#include "pre_pass_monitor.hpp"
 #include "record_block_reader.hpp"
 #include "source_normalizer.hpp"
 
@@ -172,7 +173,7 @@ private:
     void checkFixedBodySize() const;
     void checkAsciiBodySize() const;
     void describeFormat();
-    void runBoundsPrePass();
+    void runBoundsPrePass(const OpenOptions& options);
 
     std::uint64_t walkRecords(PlyBodyCursor& cursor, const PlyElement& element, std::uint64_t index,
                               const std::uint8_t* useMask, double* values) const;
@@ -231,7 +232,7 @@ PlyReader::PlyReader(const std::string& path, const OpenOptions& options) : m_st
     if (options.knownBounds) {
         m_info.sourceBounds = *options.knownBounds;
     } else {
-        runBoundsPrePass();
+        runBoundsPrePass(options);
     }
     m_info.boundsFromHeader = false;
     m_info.cube = CubeTransform::fromBounds(m_info.sourceBounds);
@@ -655,18 +656,23 @@ FloatRecordLayout PlyReader::floatLayout() const {
     return layout;
 }
 
-void PlyReader::runBoundsPrePass() {
+void PlyReader::runBoundsPrePass(const OpenOptions& options) {
     Bounds bounds;
     std::uint64_t finite = 0;
+    PrePassMonitor monitor(options, m_stream.path(), m_stream.size());
+    if (!monitor.reached(m_vertexStart)) {
+        monitor.throwCancelled();
+    }
     if (fastLayout()) {
         // Min/max of the stored floats, offset added once at the end: double(x) + offset is
         // monotonic in x, so this equals the per-point bounds read() checks against.
         const FloatRecordLayout layout = floatLayout();
         FloatBox box;
-        visitFixedBlocks([&](const std::uint8_t* records, std::size_t count, std::uint64_t) {
-            extendFloatBox(records, count, layout, box);
-            return true;
-        });
+        visitFixedBlocks(
+            [&](const std::uint8_t* records, std::size_t count, std::uint64_t firstIndex) {
+                extendFloatBox(records, count, layout, box);
+                return monitor.reached(m_vertexStart + (firstIndex + count) * m_recordBytes);
+            });
         finite = box.finite;
         if (finite > 0) {
             for (int axis = 0; axis < 3; ++axis) {
@@ -675,7 +681,7 @@ void PlyReader::runBoundsPrePass() {
             }
         }
     } else {
-        visitVertexValues([&](const double* values, std::uint64_t, std::uint64_t) {
+        visitVertexValues([&](const double* values, std::uint64_t, std::uint64_t byteOrLine) {
             const glm::dvec3 source(values[m_fields.position[0]] + m_header.offset.x,
                                     values[m_fields.position[1]] + m_header.offset.y,
                                     values[m_fields.position[2]] + m_header.offset.z);
@@ -683,9 +689,15 @@ void PlyReader::runBoundsPrePass() {
                 ++finite;
                 bounds.extend(source);
             }
-            return true;
+            // Ascii vertices are numbered by line: the bytes read so far stand for progress
+            // (the line reader reads from this thread, a block at a time).
+            return monitor.reached(binary() ? byteOrLine : m_stream.position());
         });
     }
+    if (monitor.cancelled()) {
+        monitor.throwCancelled();
+    }
+    monitor.finished();
     if (finite == 0) {
         throwNoFinitePoints();
     }

@@ -16,6 +16,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 namespace omicron {
@@ -41,6 +42,26 @@ struct OpenOptions {
     // Skips the bounds pre-pass when the caller already knows the cloud's bounds in source
     // units (a second read of the same file). Points outside them make read() throw.
     std::optional<Bounds> knownBounds;
+    // The bounds pre-pass (PLY, XYZ, LAS with unusable header bounds: a whole read of the
+    // file before any point is delivered) checks this once per block of input (1 to 4 MiB)
+    // and stops with OpenCancelled when it is set.
+    const std::atomic<bool>* cancel = nullptr;
+    // Called on the opening thread as the pre-pass advances (once per block, at its start and
+    // at its end) with the bytes scanned and the file's size; it may set *cancel.
+    std::function<void(std::uint64_t bytesScanned, std::uint64_t fileBytes)> onPrePassProgress;
+};
+
+// What openPointCloud throws when OpenOptions::cancel stopped the bounds pre-pass: not an
+// input error, the file may be fine.
+class OpenCancelled : public std::runtime_error {
+public:
+    OpenCancelled(const std::string& path, std::uint64_t bytesScanned);
+    const std::string& path() const { return m_path; }
+    std::uint64_t bytesScanned() const { return m_bytesScanned; }
+
+private:
+    std::string m_path;
+    std::uint64_t m_bytesScanned;
 };
 
 struct ReadOptions {
@@ -79,7 +100,8 @@ protected:
 // anything else unrecognised.
 CloudFormat detectFormat(const std::string& path);
 
-// Opens any supported cloud (header parsed, bounds known); throws InputError.
+// Opens any supported cloud (header parsed, bounds known); throws InputError, or
+// OpenCancelled when options.cancel stops the bounds pre-pass.
 std::unique_ptr<PointReader> openPointCloud(const std::string& path, const OpenOptions& = {});
 
 // Convenience for tests and small files: reads the whole cloud into one batch.

@@ -27,6 +27,7 @@
 #include "file_stream.hpp"
 #include "input_error.hpp"
 #include "line_reader.hpp"
+#include "pre_pass_monitor.hpp"
 #include "source_normalizer.hpp"
 
 #include <algorithm>
@@ -384,12 +385,15 @@ void scanRow(const Row& row, int intensityColumn, int colorColumn, XyzScan& scan
     }
 }
 
-XyzScan scanFile(FileStream& stream) {
+XyzScan scanFile(FileStream& stream, PrePassMonitor& monitor) {
     const std::string& path = stream.path();
     XyzScan scan;
     Row row;
     stream.seek(0);
     LineReader lines(stream);
+    if (!monitor.reached(0)) {
+        monitor.throwCancelled();
+    }
     findFirstDataLine(lines, row, scan, path);
     // The 6-column layout is not decided yet; neither candidate has a colour check here.
     const ColumnLayout layout = layoutFor(scan.columns, false);
@@ -397,10 +401,14 @@ XyzScan scanFile(FileStream& stream) {
     scanRow(row, layout.intensity, colorColumn, scan, path, scan.dataLine);
     std::string_view line;
     while (nextContentLine(lines, line)) {
+        if (!monitor.reached(lines.lineOffset())) {
+            monitor.throwCancelled();
+        }
         row.parse(line);
         checkRow(row, scan.columns, scan.dataLine, path, lines.lineNumber());
         scanRow(row, layout.intensity, colorColumn, scan, path, lines.lineNumber());
     }
+    monitor.finished();
     return scan;
 }
 
@@ -426,7 +434,8 @@ IntensityScale chooseIntensityScale(const XyzScan& scan, int column, const std::
 class XyzReader final : public PointReader {
 public:
     XyzReader(const std::string& path, const OpenOptions& options) : m_stream(path) {
-        const XyzScan scan = scanFile(m_stream);
+        PrePassMonitor monitor(options, path, m_stream.size());
+        const XyzScan scan = scanFile(m_stream, monitor);
         if (scan.bounds.empty()) {
             throw InputError(InputErrorKind::NoPoints, path, InputLocation::none(),
                              "expected at least one point with finite x y z, found " +

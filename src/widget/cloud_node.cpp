@@ -42,6 +42,7 @@ CloudNode::~CloudNode() = default;
 void CloudNode::setHierarchy(std::shared_ptr<const Hierarchy> hierarchy) {
     m_hierarchy = std::move(hierarchy);
     m_front = m_hierarchy ? std::make_unique<Front>(m_hierarchy) : nullptr;
+    m_firstDraws.reset(FirstDrawTracker::Clock::now());
     m_hierarchyChanged = true;
     m_drawList.clear();
     m_boundsScanned = 0;
@@ -159,7 +160,24 @@ void CloudNode::evaluateFront(RenderContext& context) {
     }
     context.stats->frontMs = static_cast<double>(timer.nsecsElapsed()) * 1e-6;
     context.stats->frontNodes = m_front->entries().size();
+    const std::span<const std::size_t> perLevel = m_front->entriesPerLevel();
+    std::copy(perLevel.begin(), perLevel.end(), context.stats->frontNodesPerLevel.begin());
     context.stats->placeholders = m_front->placeholderCount();
+    // The widget measures leaf -> drawn itself (recordFirstDraws); the front's own
+    // leaf -> substituted delays would only pile up.
+    (void)m_front->takeSubstitutionDelays();
+    (void)m_front->takeSubstitutionEvaluationDelays();
+}
+
+void CloudNode::recordFirstDraws() {
+    m_drawnRanges.clear();
+    for (const DrawItem& item : m_drawList) {
+        if (item.buffer != nullptr) {
+            const OctreeNode& node = m_hierarchy->node(item.level, item.index);
+            m_drawnRanges.push_back({node.coveredBegin, node.coveredCount});
+        }
+    }
+    m_firstDraws.markDrawn(*m_hierarchy, m_drawnRanges, FirstDrawTracker::Clock::now());
 }
 
 const OctreeNode& CloudNode::nodeOf(const DrawItem& item) const {
@@ -438,6 +456,9 @@ void CloudNode::render(RenderContext& context) {
         drawComputePoints(context);
     } else {
         drawPoints(context);
+    }
+    if (m_front) {
+        recordFirstDraws();
     }
     if (m_drawList.empty()) {
         context.stats->showingPreview = m_previewCount > 0;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "compute_rasterizer.hpp"
+#include "first_draw_tracker.hpp"
 #include "front.hpp"
 #include "node_buffer_cache.hpp"
 #include "node_vertices.hpp"
@@ -41,6 +42,9 @@ public:
 
     // The front of the last frame (empty without a hierarchy).
     const Front* front() const { return m_front.get(); }
+    // Leaves first drawn since the last call and their publish -> drawn delays (all the
+    // render() calls of one frame: a screenshot renders twice).
+    FirstDrawTracker::Delays takeFirstDraws() { return m_firstDraws.take(); }
 
     // Whether RenderMode::ComputePoints runs the compute rasterizer in this context (else it
     // draws GL points).
@@ -73,6 +77,7 @@ private:
     void drawPoints(RenderContext& context);
     void drawSplats(RenderContext& context);
     void drawComputePoints(RenderContext& context);
+    void recordFirstDraws();
     int effectiveColorMode(const RenderSettings& settings) const;
 
     std::shared_ptr<const Hierarchy> m_hierarchy;
@@ -82,6 +87,8 @@ private:
     std::vector<const OctreeNode*> m_packNodes;
     std::vector<std::vector<PointVertex>> m_packed;
     std::vector<DrawItem> m_drawList;
+    FirstDrawTracker m_firstDraws;
+    std::vector<FirstDrawTracker::CoveredRange> m_drawnRanges;
     std::uint64_t m_frame = 0;
     bool m_hierarchyChanged = false;
 

@@ -36,6 +36,7 @@ class CloudViewPrivate {
 public:
     SceneGraph scene;
     CloudNode* cloud = nullptr;
+    OverlayNode* overlay = nullptr;
     ViewCamera camera;
     RenderSettings settings;
     FrameStats lastStats;
@@ -57,7 +58,7 @@ public:
     CloudViewPrivate() {
         auto cloudNode = std::make_unique<CloudNode>();
         cloud = scene.add(std::move(cloudNode));
-        scene.add(std::make_unique<OverlayNode>(*cloud));
+        overlay = scene.add(std::make_unique<OverlayNode>(*cloud));
         scene.add(std::make_unique<AxisGizmoNode>());
     }
 
@@ -217,6 +218,30 @@ void CloudView::setFlyMode(bool on) {
 
 bool CloudView::flyMode() const { return d->flyMode; }
 
+void CloudView::setHighlightedNode(int level, std::uint64_t code) {
+    if (!morton::isValid(code) || morton::level(code) != level) {
+        qWarning("omicron::CloudView: node code %llx is not of level %d; highlight cleared",
+                 static_cast<unsigned long long>(code), level);
+        clearHighlightedNode();
+        return;
+    }
+    if (d->overlay->highlight() != code) {
+        d->overlay->setHighlight(code);
+        update();
+    }
+}
+
+void CloudView::clearHighlightedNode() {
+    if (d->overlay->highlight()) {
+        d->overlay->setHighlight(std::nullopt);
+        update();
+    }
+}
+
+std::optional<std::uint64_t> CloudView::highlightedNode() const {
+    return d->overlay->highlight();
+}
+
 FrameStats CloudView::lastFrameStats() const { return d->lastStats; }
 
 QString CloudView::glErrorString() const { return d->glError; }
@@ -304,6 +329,10 @@ FrameStats CloudView::renderFrame(unsigned framebuffer, int widthPx, int heightP
         stats = FrameStats{};
         d->scene.render(renderContext);
     }
+    const FirstDrawTracker::Delays firstDraws = d->cloud->takeFirstDraws();
+    stats.leavesFirstDrawn = firstDraws.leaves;
+    stats.leafDrawDelayMedianMs = firstDraws.medianMs;
+    stats.leafDrawDelayMaxMs = firstDraws.maxMs;
     stats.frameMs = static_cast<double>(timer.nsecsElapsed()) * 1e-6;
     return stats;
 }

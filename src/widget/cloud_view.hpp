@@ -48,6 +48,14 @@ public:
     void setFlyMode(bool on);
     bool flyMode() const;
 
+    // Draws the cell of one node as a box over the cloud (magenta, through the points),
+    // whatever the overlay settings: e.g. the node selected in a tree of the hierarchy.
+    // `code` is the node's Morton code with its sentinel bit; `level` must be its level
+    // (a mismatch clears the highlight). The highlight stays until cleared or replaced.
+    void setHighlightedNode(int level, std::uint64_t code);
+    void clearHighlightedNode();
+    std::optional<std::uint64_t> highlightedNode() const;
+
     // Statistics of the last frame drawn.
     FrameStats lastFrameStats() const;
 

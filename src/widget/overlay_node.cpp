@@ -14,6 +14,8 @@ constexpr std::size_t kMaxCellsDrawn = 20000;
 
 constexpr std::uint8_t kBoxColor[4] = {200, 200, 200, 255};
 constexpr std::uint8_t kCutColor[4] = {255, 140, 0, 255};
+// The highlighted node: magenta, a colour no other overlay and no colour mode's ramp uses.
+constexpr std::uint8_t kHighlightColor[4] = {255, 0, 255, 255};
 
 } // namespace
 
@@ -81,6 +83,18 @@ void OverlayNode::render(RenderContext& context) {
             }
         }
     }
+    // The highlight goes last and is drawn without the depth test: a selected node stays
+    // visible inside or behind the cloud. Two boxes, the second 1 % larger, for a bolder line
+    // (core profiles have no wide lines).
+    const std::size_t highlightBegin = m_lines.size();
+    if (m_highlight && morton::isValid(*m_highlight) &&
+        morton::level(*m_highlight) <= morton::kMaxLevel) {
+        glm::dvec3 min, max;
+        cellBounds(*m_highlight, min, max);
+        addBox(min, max, kHighlightColor);
+        const glm::dvec3 grow = (max - min) * 0.005;
+        addBox(min - grow, max + grow, kHighlightColor);
+    }
     if (m_lines.empty()) {
         return;
     }
@@ -103,7 +117,13 @@ void OverlayNode::render(RenderContext& context) {
     const glm::mat4 viewProjection(context.projection * context.view);
     m_program->setUniformValue("u_viewProjection",
                                QMatrix4x4(glm::value_ptr(viewProjection)).transposed());
-    gl.glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(m_lines.size()));
+    gl.glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(highlightBegin));
+    if (highlightBegin < m_lines.size()) {
+        gl.glDisable(GL_DEPTH_TEST);
+        gl.glDrawArrays(GL_LINES, static_cast<GLint>(highlightBegin),
+                        static_cast<GLsizei>(m_lines.size() - highlightBegin));
+        gl.glEnable(GL_DEPTH_TEST);
+    }
     m_program->release();
     gl.glDisable(GL_BLEND);
     gl.glDepthFunc(GL_LESS);

@@ -1,6 +1,7 @@
 // Line overlays drawn after the cloud: the cloud's bounding box, the cells of the front's
 // nodes (coloured by level; optional) and the oblique cut's boundary — the leaves the builder
-// has inserted that are not settled yet, where the sweep is working now.
+// has inserted that are not settled yet, where the sweep is working now — and the cell of a
+// highlighted node (CloudView::setHighlightedNode), drawn over the points.
 #pragma once
 
 #include "scene_node.hpp"
@@ -8,6 +9,7 @@
 #include <QOpenGLShaderProgram>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace omicron {
@@ -22,6 +24,10 @@ public:
     void render(RenderContext& context) override;
     void releaseGL(QOpenGLExtraFunctions& gl) override;
 
+    // The node whose cell is drawn as a box (a Morton code with its sentinel bit), or none.
+    void setHighlight(std::optional<std::uint64_t> code) { m_highlight = code; }
+    std::optional<std::uint64_t> highlight() const { return m_highlight; }
+
     struct LineVertex {
         float x, y, z;
         std::uint8_t r, g, b, a;
@@ -31,6 +37,7 @@ private:
     void addBox(const glm::dvec3& min, const glm::dvec3& max, const std::uint8_t (&rgba)[4]);
 
     const CloudNode& m_cloud;
+    std::optional<std::uint64_t> m_highlight;
     std::vector<LineVertex> m_lines;
     std::unique_ptr<QOpenGLShaderProgram> m_program;
     unsigned m_vao = 0;

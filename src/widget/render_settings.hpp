@@ -1,7 +1,10 @@
 // Value types of the CloudView API: what to draw and how, and what a frame cost.
 #pragma once
 
+#include "morton.hpp"
+
 #include <QMetaType>
+#include <array>
 #include <cstddef>
 
 namespace omicron {
@@ -43,6 +46,8 @@ struct FrameStats {
     double frontMs = 0.0;  // front evaluation alone
     double fps = 0.0;      // frames per second over the last second
     std::size_t frontNodes = 0;
+    // frontNodes by level 0..morton::kMaxLevel (placeholders at their leaf's level).
+    std::array<std::size_t, morton::kMaxLevel + 1> frontNodesPerLevel{};
     std::size_t placeholders = 0;
     std::size_t nodesDrawn = 0;
     std::size_t pointsDrawn = 0;
@@ -50,6 +55,12 @@ struct FrameStats {
     std::size_t uploads = 0;       // node buffers uploaded this frame
     std::size_t gpuBytes = 0;      // node buffers resident on the GPU
     bool showingPreview = false;
+    // The paper's front insertion delay: leaves of the builder's insertion log whose points
+    // this frame drew for the first time (by their own node or an ancestor standing for them),
+    // and the time from the builder publishing each of them to this frame.
+    std::size_t leavesFirstDrawn = 0;
+    double leafDrawDelayMedianMs = 0.0;
+    double leafDrawDelayMaxMs = 0.0;
 };
 
 } // namespace omicron

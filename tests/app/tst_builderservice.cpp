@@ -3,15 +3,20 @@
 // reports bad files by name, and stops promptly on cancel and destruction.
 #include "app_test_support.hpp"
 #include "builder_service.hpp"
+#include "ply_writer.hpp"
 #include "point_reader.hpp"
+#include "scene_generator.hpp"
 
 #include <QElapsedTimer>
-#include <QFile>
 #include <QFile>
 #include <QFileInfo>
 #include <QSignalSpy>
 #include <QTemporaryDir>
 #include <QtTest>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
 
 using namespace omicron;
 
@@ -57,6 +62,7 @@ private slots:
     void exportsLoadBackIdentically();
     void savedHierarchyLoadsBackWithIdenticalStatistics();
     void cancelMidBuildEndsTheRun();
+    void cancelDuringTheBoundsPrePassKeepsThePreviousCloud();
     void destroyingMidBuildJoinsEveryThread();
     void newOpenWhileBusyReplacesTheRunningBuild();
 };
@@ -260,6 +266,73 @@ void TestBuilderService::cancelMidBuildEndsTheRun() {
     QVERIFY2(clock.elapsed() < 10'000, qPrintable(QString::number(clock.elapsed())));
     QTRY_VERIFY(!service.busy());
     QVERIFY(!service.hasCompleteCloud());
+}
+
+// Cancel while a PLY file is scanned for its bounds (before any point streams): the run ends
+// cancelled, the file was never read into the sorter, and the previous cloud and hierarchy
+// stay. The worker waits inside the scan until the GUI thread has seen the scan in the
+// progress signal and pressed Cancel, so the order does not depend on timing.
+void TestBuilderService::cancelDuringTheBoundsPrePassKeepsThePreviousCloud() {
+    QTemporaryDir dir;
+    const QString path = dir.filePath(QStringLiteral("scan.ply"));
+    PlyWriteOptions ascii;
+    ascii.encoding = PlyEncoding::Ascii; // about 10 MB: ten blocks of scanning
+    const GeneratedScene scene = generateScene(150'000, 3);
+    writePly(path.toStdString(), scene.points, scene.cube, ascii);
+
+    std::mutex mutex;
+    std::condition_variable pressed;
+    bool cancelPressed = false;
+    std::atomic<int> reports{0};
+    BuilderService service; // after what its worker's observer uses: destroyed first
+    service.setOptions(testOptions(6));
+    QSignalSpy finished(&service, &BuilderService::buildFinished);
+    QSignalSpy failed(&service, &BuilderService::failed);
+    QSignalSpy progress(&service, &BuilderService::progressChanged);
+    service.openGeneratedScene(20'000, 3);
+    QVERIFY(waitForBuild(finished, failed).stats.complete);
+    QTRY_VERIFY(!service.busy());
+    const auto keptHierarchy = service.hierarchy();
+    const std::uint64_t reads = service.sourceReads();
+
+    service.setPrePassObserver([&](std::uint64_t, std::uint64_t) {
+        if (++reports == 2) { // after the first block
+            std::unique_lock lock(mutex);
+            pressed.wait_for(lock, std::chrono::seconds(60), [&] { return cancelPressed; });
+        }
+    });
+    progress.clear();
+    service.open(path);
+    const auto scanning = [&] {
+        for (const QList<QVariant>& signal : progress) {
+            const auto p = signal.at(0).value<PipelineProgress>();
+            if (p.phase == BuildPhase::Opening && p.bytesScanned > 0 &&
+                p.bytesScanned < p.bytesToScan) {
+                return true;
+            }
+        }
+        return false;
+    };
+    QTRY_VERIFY_WITH_TIMEOUT(scanning(), kBuildTimeoutMs);
+    service.cancel();
+    {
+        std::lock_guard lock(mutex);
+        cancelPressed = true;
+    }
+    pressed.notify_all();
+    const PipelineResult result = waitForBuild(finished, failed);
+    QTRY_VERIFY(!service.busy());
+    service.setPrePassObserver({});
+    QVERIFY(result.cancelled);
+    QCOMPARE(failed.count(), 0);
+    QCOMPARE(reports.load(), 2); // the scan stopped at its next block
+    const PipelineProgress last = service.pipeline().progress();
+    QCOMPARE(last.phase, BuildPhase::Cancelled);
+    QVERIFY(last.bytesScanned < last.bytesToScan);
+    QCOMPARE(service.hierarchy(), keptHierarchy);
+    QVERIFY(service.hasCompleteCloud());
+    QCOMPARE(service.sourceReads(), reads);
+    QCOMPARE(service.source()->kind, PipelineKind::GeneratedScene);
 }
 
 void TestBuilderService::destroyingMidBuildJoinsEveryThread() {

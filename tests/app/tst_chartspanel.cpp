@@ -15,6 +15,7 @@ class TestChartsPanel : public QObject {
     Q_OBJECT
 private slots:
     void samplesProgressAndFrames();
+    void chartsTheLeafToDrawnDelayOfTheFrames();
     void exportsPngAndCsv();
     void exportErrorsNameTheFile();
 };
@@ -35,7 +36,12 @@ void TestChartsPanel::samplesProgressAndFrames() {
     progress.pointsSorted = 400;
     progress.pointsInserted = 100;
     panel.setProgress(progress);
-    panel.setFrame(12.0, 3.0, 40.0, 77);
+    FrameStats frame;
+    frame.frameMs = 12.0;
+    frame.frontMs = 3.0;
+    frame.fps = 40.0;
+    frame.frontNodes = 77;
+    panel.setFrame(frame);
     QTRY_VERIFY(inserted->line(0)->count() >= 2);
     QCOMPARE(inserted->line(0)->points().last().y(), 100.0);
     QCOMPARE(inserted->line(1)->points().last().y(), 400.0);
@@ -58,6 +64,45 @@ void TestChartsPanel::samplesProgressAndFrames() {
     QTest::qWait(1000);
     QVERIFY(memory->line(0)->count() - before <= 11);
     QVERIFY(memory->line(0)->points().last().y() > 0.0);
+}
+
+// The front insertion delay series: the frames' leaf -> drawn delays gathered between two
+// samples, their median weighted by leaf counts and their maximum; the sorted -> inserted
+// delay stays as its own line.
+void TestChartsPanel::chartsTheLeafToDrawnDelayOfTheFrames() {
+    ChartsPanel panel;
+    panel.resize(900, 400);
+    panel.show();
+    TimeSeriesChart* delay = panel.chart(QStringLiteral("Insertion delay"));
+    QVERIFY(delay != nullptr);
+    QCOMPARE(delay->lineCount(), 3);
+    QVERIFY(delay->line(0)->name().contains(QStringLiteral("drawn")));
+    QVERIFY(delay->line(2)->name().contains(QStringLiteral("sorted -> inserted")));
+    panel.startBuild();
+    // Three frames before the next sample: 10 leaves at 40 ms (max 90), 1 at 5 ms (max 5),
+    // 30 at 70 ms (max 300); one frame that drew no new leaf.
+    const auto frame = [&](std::size_t leaves, double medianMs, double maxMs) {
+        FrameStats stats;
+        stats.leavesFirstDrawn = leaves;
+        stats.leafDrawDelayMedianMs = medianMs;
+        stats.leafDrawDelayMaxMs = maxMs;
+        panel.setFrame(stats);
+    };
+    QTest::qWait(2 * ChartsPanel::kSampleIntervalMs); // a sample with no leaves: no point
+    QCOMPARE(delay->line(0)->count(), 0);
+    frame(10, 40.0, 90.0);
+    frame(1, 5.0, 5.0);
+    frame(0, 0.0, 0.0);
+    frame(30, 70.0, 300.0);
+    QTRY_COMPARE(delay->line(0)->count(), 1);
+    QCOMPARE(delay->line(0)->at(0).y(), 70.0); // 30 of the 41 leaves are at 70 ms
+    QCOMPARE(delay->line(1)->at(0).y(), 300.0);
+    QTest::qWait(3 * ChartsPanel::kSampleIntervalMs);
+    QCOMPARE(delay->line(0)->count(), 1); // nothing new drawn: no new point
+    frame(4, 12.0, 20.0);
+    QTRY_COMPARE(delay->line(1)->count(), 2);
+    QCOMPARE(delay->line(0)->at(1).y(), 12.0);
+    QCOMPARE(delay->line(1)->at(1).y(), 20.0); // the window's own maximum, not the build's
 }
 
 void TestChartsPanel::exportsPngAndCsv() {

@@ -33,6 +33,7 @@ private slots:
     void passesTheModelTesterThroughABuild();
     void reportsTheNumbersOfEachLevel();
     void unchangedRowsEmitNothing();
+    void frontNodesFillTheirColumn();
 };
 
 void TestLevelModel::passesTheModelTesterThroughABuild() {
@@ -87,6 +88,34 @@ void TestLevelModel::unchangedRowsEmitNothing() {
     QCOMPARE(changed.count(), 1);
     QCOMPARE(changed.first().at(0).toModelIndex().row(), 3);
     QCOMPARE(reset.count(), 0);
+}
+
+// The view's front per level: its own column, changed cells only, kept for deeper levels
+// until the statistics of a deeper build add their rows.
+void TestLevelModel::frontNodesFillTheirColumn() {
+    LevelModel model;
+    QAbstractItemModelTester tester(&model, QAbstractItemModelTester::FailureReportingMode::QtTest);
+    model.setStatistics(statistics(3, 1));
+    QSignalSpy changed(&model, &QAbstractItemModel::dataChanged);
+    const std::vector<std::size_t> front{1, 0, 12, 40, 0, 7}; // levels 4, 5: not in the table yet
+    model.setFrontNodes(front);
+    QCOMPARE(changed.count(), 3); // levels 0, 2 and 3
+    for (const QList<QVariant>& signal : changed) {
+        QCOMPARE(signal.at(0).toModelIndex().column(), int(LevelModel::FrontNodes));
+        QCOMPARE(signal.at(1).toModelIndex().column(), int(LevelModel::FrontNodes));
+    }
+    QCOMPARE(model.value(3, LevelModel::FrontNodes), quint64(40));
+    QCOMPARE(model.index(2, LevelModel::FrontNodes).data(Qt::EditRole).toULongLong(), quint64(12));
+    QCOMPARE(model.headerData(LevelModel::FrontNodes, Qt::Horizontal).toString(),
+             QStringLiteral("Front nodes"));
+    changed.clear();
+    model.setFrontNodes(front);
+    QCOMPARE(changed.count(), 0);
+    model.setStatistics(statistics(5, 1)); // a deeper build: its rows show what was kept
+    QCOMPARE(model.value(5, LevelModel::FrontNodes), quint64(7));
+    model.setFrontNodes(std::vector<std::size_t>{1}); // a shorter front: the rest is 0
+    QCOMPARE(model.value(3, LevelModel::FrontNodes), quint64(0));
+    QCOMPARE(model.value(0, LevelModel::FrontNodes), quint64(1));
 }
 
 QTEST_MAIN(TestLevelModel)

@@ -8,29 +8,64 @@
 #include "charts_panel.hpp"
 #include "cloud_view.hpp"
 #include "cut_panel.hpp"
+#include "hierarchy_model.hpp"
 #include "level_model.hpp"
 #include "main_window.hpp"
+#include "time_series_chart.hpp"
 
 #include <QAbstractItemModelTester>
 #include <QAction>
 #include <QComboBox>
 #include <QElapsedTimer>
 #include <QFile>
+#include <QFileInfo>
 #include <QImage>
+#include <QLineSeries>
 #include <QMessageBox>
 #include <QSettings>
-#include <QFileInfo>
 #include <QSignalSpy>
 #include <QStandardPaths>
 #include <QSurfaceFormat>
 #include <QTemporaryDir>
+#include <QTreeView>
 #include <QtTest>
 
 using namespace omicron;
 
 namespace {
 constexpr int kBuildTimeoutMs = 120'000;
+
+// Pixels in the highlight's magenta (red and blue high, green low).
+int magentaPixels(const QImage& image) {
+    int count = 0;
+    for (int y = 0; y < image.height(); ++y) {
+        for (int x = 0; x < image.width(); ++x) {
+            const QColor c = image.pixelColor(x, y);
+            count += c.red() > 200 && c.blue() > 200 && c.green() < 80 ? 1 : 0;
+        }
+    }
+    return count;
 }
+
+// The level table's "Front nodes" column against the view's last frame: the same numbers,
+// adding up to the front's size.
+bool frontColumnMatchesTheView(const MainWindow& window) {
+    const FrameStats stats = window.cloudView()->lastFrameStats();
+    const LevelModel* levels = window.cutPanel()->levelModel();
+    std::size_t sum = 0, perLevel = 0;
+    for (int level = 0; level < levels->rowCount(); ++level) {
+        const quint64 shown = levels->value(level, LevelModel::FrontNodes);
+        if (shown != stats.frontNodesPerLevel[static_cast<std::size_t>(level)]) {
+            return false;
+        }
+        sum += shown;
+    }
+    for (const std::size_t count : stats.frontNodesPerLevel) {
+        perLevel += count;
+    }
+    return stats.frontNodes > 0 && sum == stats.frontNodes && perLevel == stats.frontNodes;
+}
+} // namespace
 
 class TestMainWindowGL : public QObject {
     Q_OBJECT
@@ -41,6 +76,7 @@ private slots:
     void savedHierarchyOpensThroughTheFileMenu();
     void closingMidBuildReturnsPromptly();
     void renderModeMenuAndPanelDriveTheView();
+    void hierarchyTreeSelectionHighlightsTheNodeInTheView();
 };
 
 void TestMainWindowGL::initTestCase() {
@@ -61,6 +97,8 @@ void TestMainWindowGL::openingASharedFileBuildsAndFillsThePanels() {
         QVERIFY(QTest::qWaitForWindowExposed(&window));
         QAbstractItemModelTester tester(window.cutPanel()->levelModel(),
                                         QAbstractItemModelTester::FailureReportingMode::QtTest);
+        QAbstractItemModelTester treeTester(window.cutPanel()->hierarchyModel(),
+                                            QAbstractItemModelTester::FailureReportingMode::QtTest);
         QSignalSpy finished(window.service(), &BuilderService::buildFinished);
         window.openFile(path);
         QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 1, kBuildTimeoutMs);
@@ -77,6 +115,10 @@ void TestMainWindowGL::openingASharedFileBuildsAndFillsThePanels() {
         QCOMPARE(levels->value(0, LevelModel::CutRoots), quint64(1));
         QCOMPARE(levels->value(0, LevelModel::Nodes), quint64(1));
         QCOMPARE(window.recentFiles().value(0), path);
+        // The view's frames fill the "Front nodes" column; the tree holds the finished root.
+        QTRY_VERIFY_WITH_TIMEOUT(frontColumnMatchesTheView(window), kBuildTimeoutMs);
+        QCOMPARE(window.cutPanel()->hierarchyModel()->rowCount(), 1);
+        QCOMPARE(window.cutPanel()->hierarchyModel()->hierarchy(), window.service()->hierarchy());
 
         // Rebuild from the panel: no re-read, a deeper table.
         BuilderService* service = window.service();
@@ -230,6 +272,47 @@ void TestMainWindowGL::renderModeMenuAndPanelDriveTheView() {
         QCOMPARE(legacy.cloudView()->renderSettings().mode, RenderMode::Splats);
     }
     QSettings().remove(QStringLiteral("view"));
+}
+
+// The cut panel's Hierarchy box: selecting a node shows its details and draws its cell in the view
+// (the widget's highlight, and magenta pixels in its frame); clearing the selection removes it. The
+// same build feeds the insertion delay chart its leaf -> drawn series.
+void TestMainWindowGL::hierarchyTreeSelectionHighlightsTheNodeInTheView() {
+    MainWindow window;
+    window.resize(1400, 900);
+    window.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&window));
+    CutPanel* panel = window.cutPanel();
+    QAbstractItemModelTester tester(panel->hierarchyModel(),
+                                    QAbstractItemModelTester::FailureReportingMode::QtTest);
+    QSignalSpy finished(window.service(), &BuilderService::buildFinished);
+    window.openDefaultScene(1'000'000);
+    QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 1, kBuildTimeoutMs);
+    QTRY_VERIFY(!window.service()->busy());
+    QTRY_COMPARE(panel->hierarchyModel()->rowCount(), 1);
+
+    // Leaves published after the view attached were drawn: the front insertion delay chart.
+    TimeSeriesChart* delay = window.chartsPanel()->chart(QStringLiteral("Insertion delay"));
+    QVERIFY(delay != nullptr);
+    QTRY_VERIFY_WITH_TIMEOUT(delay->line(0)->count() > 0, kBuildTimeoutMs);
+    QVERIFY(delay->line(1)->count() > 0);
+    QVERIFY(delay->line(0)->points().last().y() <= delay->line(1)->points().last().y());
+
+    CloudView* view = window.cloudView();
+    const int before = magentaPixels(view->grabFramebuffer());
+    const auto hierarchy = window.service()->hierarchy();
+    const morton::Code code = hierarchy->node(1, 0).code;
+    QVERIFY(panel->selectNode(code));
+    QCOMPARE(view->highlightedNode(), std::optional<std::uint64_t>(code));
+    QVERIFY(panel->nodeDetails().contains(QStringLiteral("0x%1").arg(code, 0, 16)));
+    const int highlighted = magentaPixels(view->grabFramebuffer());
+    QVERIFY2(highlighted > before + 100,
+             qPrintable(QStringLiteral("%1 -> %2").arg(before).arg(highlighted)));
+
+    panel->hierarchyTree()->selectionModel()->clearCurrentIndex();
+    QVERIFY(!panel->selectedNode());
+    QVERIFY(!view->highlightedNode());
+    QCOMPARE(magentaPixels(view->grabFramebuffer()), before);
 }
 
 int main(int argc, char* argv[]) {

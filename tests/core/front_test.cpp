@@ -5,11 +5,14 @@
 #include "front.hpp"
 #include "front_projection.hpp"
 #include "hierarchy_test_support.hpp"
+#include "omh_reader.hpp"
+#include "omh_writer.hpp"
+#include "test_files.hpp"
 
 #include <atomic>
-#include <cstdio>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <gtest/gtest.h>
 #include <random>
 #include <thread>
@@ -65,6 +68,17 @@ int settle(Front& front, const FrontCamera& camera, const FrontOptions& options,
     return limit;
 }
 
+// The front's own per-level counts against a walk of its entries.
+void expectEntriesPerLevelMatch(const Front& front) {
+    const std::span<const std::size_t> counts = front.entriesPerLevel();
+    ASSERT_EQ(counts.size(), static_cast<std::size_t>(front.hierarchy().maxLevel()) + 1);
+    std::vector<std::size_t> walked(counts.size(), 0);
+    for (const FrontEntry& entry : front.entries()) {
+        ++walked[static_cast<std::size_t>(entry.level())];
+    }
+    EXPECT_EQ(std::vector<std::size_t>(counts.begin(), counts.end()), walked);
+}
+
 std::size_t countLeaves(const Hierarchy& hierarchy) {
     std::size_t leaves = 0;
     for (int level = 0; level <= hierarchy.maxLevel(); ++level) {
@@ -115,6 +129,8 @@ TEST(Front, EntersACompleteHierarchyFromTheRootAndReachesEveryLeaf) {
     settle(front, orthographic(1e9), unlimited(0.0));
     const Hierarchy& hierarchy = front.hierarchy();
     EXPECT_EQ(front.entries().size(), countLeaves(hierarchy));
+    expectEntriesPerLevelMatch(front);
+    EXPECT_EQ(front.entriesPerLevel()[0], 0u) << "branched all the way to the leaves";
     EXPECT_EQ(front.placeholderCount(), 0u);
     for (const FrontEntry& entry : front.entries()) {
         EXPECT_TRUE(hierarchy.node(entry.level(), entry.index).isLeaf());
@@ -124,6 +140,32 @@ TEST(Front, EntersACompleteHierarchyFromTheRootAndReachesEveryLeaf) {
     settle(front, orthographic(1e-3), unlimited(1.0));
     ASSERT_EQ(front.entries().size(), 1u);
     EXPECT_EQ(front.entries()[0].code, morton::kRoot);
+    expectEntriesPerLevelMatch(front);
+    EXPECT_EQ(front.entriesPerLevel()[0], 1u);
+}
+
+// A hierarchy loaded from a .omh file (its nodes hold their own points, CloudOrder::NodeOrder,
+// not their subtree's input range): the front enters it from the root, branches to every leaf
+// and back, and its invariants hold all the way (the debug preset checks them every frame).
+TEST(Front, WalksALoadedHierarchyWithItsInvariants) {
+    const auto cloud = makeCloud(Shape::Random, 20000, 5);
+    const auto build = buildSynthetic(cloud, frontBuildOptions(5));
+    test::TempDir dir;
+    const std::string path = dir.file("front.omh");
+    writeOmh(path, build.builder->hierarchy(),
+             omhBuildInfo(build.builder->options(), build.builder->statistics()));
+    OmhReader reader(path);
+    const auto loaded = reader.hierarchy();
+    reader.load();
+    ASSERT_EQ(loaded->cloud().order(), CloudOrder::NodeOrder);
+    Front front(loaded);
+    settle(front, orthographic(1e9), unlimited(0.0));
+    EXPECT_EQ(front.entries().size(), countLeaves(*loaded));
+    EXPECT_EQ(front.checkInvariants(), "");
+    expectEntriesPerLevelMatch(front);
+    settle(front, orthographic(1e-3), unlimited(1.0));
+    ASSERT_EQ(front.entries().size(), 1u);
+    EXPECT_EQ(front.checkInvariants(), "");
 }
 
 // Orthographic: a node's size depends only on its level, so the threshold can be put exactly
@@ -360,6 +402,8 @@ TEST_P(FrontConcurrency, InvariantsHoldAndSettledLeavesAreSubstitutedWhileBuildi
         sweepsBefore.push_back(sweeps);
         substituted += result.substituted;
         ASSERT_EQ(front.checkInvariants(), "") << "evaluation " << evaluation;
+        // Placeholders, substitutions, prunes and branches all move the per-level counts.
+        expectEntriesPerLevelMatch(front);
         if (param.pointBudget > 0 && !result.overBudget) {
             ASSERT_LE(result.visiblePoints, param.pointBudget);
         }

@@ -1,9 +1,11 @@
 // CloudView under a real GL context (Xvfb + Mesa llvmpipe in CI): what it draws, checked by
 // pixel statistics of renderImage() from fixed cameras.
+#include "build_pipeline.hpp"
 #include "cloud_view.hpp"
 #include "hierarchy_builder.hpp"
 #include "morton_sorter.hpp"
 #include "point_reader.hpp"
+#include "scene_generator.hpp"
 #include "widget_test_support.hpp"
 
 #include <QSignalSpy>
@@ -35,6 +37,26 @@ PreviewSample spherePreview(std::size_t count) {
     }
     preview.pointsSeen = count;
     return preview;
+}
+
+std::shared_ptr<const Hierarchy> generatedHierarchy(std::uint64_t points) {
+    BuildPipeline pipeline; // the hierarchy outlives it (shared)
+    PipelineOptions options;
+    options.build.maxLevel = 7;
+    pipeline.runGeneratedScene(points, 1, options);
+    return pipeline.hierarchy();
+}
+
+// Pixels of `image` in the highlight's magenta (red and blue high, green low).
+int magentaPixels(const QImage& image) {
+    int count = 0;
+    for (int y = 0; y < image.height(); ++y) {
+        for (int x = 0; x < image.width(); ++x) {
+            const QColor c = image.pixelColor(x, y);
+            count += c.red() > 200 && c.blue() > 200 && c.green() < 80 ? 1 : 0;
+        }
+    }
+    return count;
 }
 
 } // namespace
@@ -108,6 +130,130 @@ private slots:
         QVERIFY2(pointCoverage > 0.05, qPrintable(QString::number(pointCoverage)));
         QVERIFY2(std::abs(splatCoverage - pointCoverage) < 0.25 * pointCoverage,
                  qPrintable(QString("%1 vs %2").arg(splatCoverage).arg(pointCoverage)));
+    }
+
+    // FrameStats carries the front's nodes per level; they add up to the front's size.
+    void frontNodesPerLevelAddUpToTheFront() {
+        const auto hierarchy = generatedHierarchy(60'000);
+        CloudView view;
+        view.setRenderSettings(plainSettings());
+        view.setHierarchy(hierarchy);
+        QVERIFY2(!view.renderImage(QSize(320, 240)).isNull(), qPrintable(view.glErrorString()));
+        const FrameStats stats = view.lastFrameStats();
+        QVERIFY(stats.frontNodes > 1);
+        std::size_t sum = 0;
+        int levelsUsed = 0;
+        for (std::size_t level = 0; level < stats.frontNodesPerLevel.size(); ++level) {
+            sum += stats.frontNodesPerLevel[level];
+            levelsUsed += stats.frontNodesPerLevel[level] > 0 ? 1 : 0;
+            if (level > static_cast<std::size_t>(hierarchy->maxLevel())) {
+                QCOMPARE(stats.frontNodesPerLevel[level], std::size_t{0});
+            }
+        }
+        QCOMPARE(sum, stats.frontNodes);
+        QVERIFY(levelsUsed >= 1);
+    }
+
+    // setHighlightedNode draws the node's cell as a magenta box through the points, whatever
+    // the overlay settings; clearing it restores the image.
+    void highlightedNodeIsDrawnAsABox() {
+        const auto hierarchy = generatedHierarchy(60'000);
+        CloudView view;
+        view.setRenderSettings(plainSettings());
+        view.setHierarchy(hierarchy);
+        view.setStandardView(StandardView::Iso);
+        const QImage plain = view.renderImage(QSize(320, 240));
+        QVERIFY2(!plain.isNull(), qPrintable(view.glErrorString()));
+        QCOMPARE(magentaPixels(plain), 0);
+
+        QVERIFY(hierarchy->nodeCount(1) > 0);
+        const std::uint64_t code = hierarchy->node(1, 0).code;
+        view.setHighlightedNode(1, code);
+        QCOMPARE(view.highlightedNode(), std::optional<std::uint64_t>(code));
+        const QImage highlighted = view.renderImage(QSize(320, 240));
+        const int boxPixels = magentaPixels(highlighted);
+        // Twelve edges of a cell an eighth of the cloud's cube: well over a hundred pixels.
+        QVERIFY2(boxPixels > 100, qPrintable(QString::number(boxPixels)));
+        int changed = 0;
+        for (int y = 0; y < plain.height(); ++y) {
+            for (int x = 0; x < plain.width(); ++x) {
+                changed += plain.pixel(x, y) != highlighted.pixel(x, y) ? 1 : 0;
+            }
+        }
+        QVERIFY(changed >= boxPixels);
+
+        view.clearHighlightedNode();
+        QVERIFY(!view.highlightedNode().has_value());
+        QCOMPARE(magentaPixels(view.renderImage(QSize(320, 240))), 0);
+
+        // A code that is not of the given level clears the highlight.
+        view.setHighlightedNode(1, code);
+        QTest::ignoreMessage(QtWarningMsg, QRegularExpression("not of level 3"));
+        view.setHighlightedNode(3, code);
+        QVERIFY(!view.highlightedNode().has_value());
+    }
+
+    // The front insertion delay (leaf published -> first drawn) through a real build: every
+    // leaf the builder logs after the view attached is counted exactly once over the frames,
+    // each frame with its median below its maximum.
+    void leafDrawDelayIsMeasuredWhileABuildRuns() {
+        const GeneratedScene scene = generateScene(150'000, 4);
+        CloudInfo info;
+        info.pointCount = scene.points.size();
+        info.attributes = scene.points.attributes;
+        info.sourceBounds = scene.sourceBounds;
+        info.cube = scene.cube;
+        SortOptions sortOptions;
+        sortOptions.batchPoints = 10'000;
+        IncrementalMortonSorter sorter(info, sortOptions);
+        sorter.add(scene.points);
+        std::vector<std::pair<std::size_t, std::size_t>> ranges;
+        sorter.sortAndEmit([&](const SortedCloud&, std::size_t begin, std::size_t end) {
+            ranges.emplace_back(begin, end);
+        });
+        QVERIFY(ranges.size() >= 8);
+
+        BuildOptions options;
+        options.maxLevel = 7;
+        HierarchyBuilder builder(sorter.cloud(), options);
+        CloudView view;
+        view.setRenderSettings(plainSettings());
+        view.setHierarchy(builder.sharedHierarchy()); // before the first leaf is published
+        ViewCamera camera; // the whole cube in view: every leaf gets drawn in the end
+        camera.setSceneBox(glm::dvec3(0.0), glm::dvec3(1.0));
+        camera.setStandardView(StandardView::Iso);
+        view.setCamera(camera);
+
+        std::size_t firstDrawn = 0;
+        int framesWithLeaves = 0;
+        bool delaysOrdered = true;
+        const auto count = [&](const FrameStats& stats) {
+            firstDrawn += stats.leavesFirstDrawn;
+            framesWithLeaves += stats.leavesFirstDrawn > 0 ? 1 : 0;
+            delaysOrdered = delaysOrdered && stats.leafDrawDelayMedianMs >= 0.0 &&
+                            stats.leafDrawDelayMedianMs <= stats.leafDrawDelayMaxMs &&
+                            (stats.leavesFirstDrawn > 0 || stats.leafDrawDelayMaxMs == 0.0);
+        };
+        // The shown (off-screen) view also paints on its own: those frames count too.
+        connect(&view, &CloudView::frameRendered, this, count);
+        const auto frame = [&] {
+            QVERIFY2(!view.renderImage(QSize(200, 200)).isNull(), qPrintable(view.glErrorString()));
+            count(view.lastFrameStats());
+        };
+        for (const auto& [begin, end] : ranges) {
+            builder.onSortedRange(*sorter.cloud(), begin, end);
+            frame();
+        }
+        builder.finish();
+        builder.wait();
+        frame();
+        frame(); // converged: nothing new
+        QCOMPARE(view.lastFrameStats().leavesFirstDrawn, std::size_t{0});
+        const std::size_t leaves = builder.hierarchy().insertionCount();
+        QVERIFY(leaves > 0);
+        QCOMPARE(firstDrawn, leaves);
+        QVERIFY(framesWithLeaves >= 2);
+        QVERIFY(delaysOrdered);
     }
 
     // The renderer reads the hierarchy while the builder grows it (another thread): every
