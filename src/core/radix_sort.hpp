@@ -1,12 +1,17 @@
 // Parallel, stable radix sort of 64-bit keys carrying 32-bit values (point indices).
 //
-// Most-significant-digit first: one stable counting pass distributes the keys by the top
-// varying digit into buckets (histograms per fixed block of keys, all blocks in parallel),
-// then every bucket is sorted the same way, independently and in parallel, until buckets are
-// small enough for a stable insertion sort. Digits are taken only where keys actually differ,
-// so clustered Morton codes (many equal high bits) cost no empty passes. Buckets and blocks
-// are fixed by the data, not by the thread count, and every step is stable, so the output is
-// the same for any number of threads (it is the unique stable order).
+// Most-significant digit first, on the bits where keys actually differ (one OR pass finds
+// them), so clustered Morton codes cost no passes over equal high bits:
+// - A range of 2^16 keys or more is distributed by all threads in one stable counting
+//   scatter by its top digit (up to 14 bits wide, aiming at buckets of ~2^11 keys):
+//   histograms per fixed block of keys, a prefix in (digit, block) order, every block
+//   scattering on its own. Buckets are then sorted in parallel, each by one thread in cache.
+// - A cache-resident range is sorted in place by its two highest digits (up to 12 bits each)
+//   least significant first: one pass counts both, two stable scatters go there and back.
+//   For point-cloud codes that leaves few keys equal on all bits down to the low digit; such
+//   groups are finished by insertion sort (up to 16 keys) or the same step on the bits below.
+// Blocks and buckets are fixed by the data, not by the thread count, and every step is
+// stable, so the output is the same for any number of threads (it is the unique stable order).
 #pragma once
 
 #include <cstdint>
