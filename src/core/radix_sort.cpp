@@ -274,6 +274,24 @@ std::vector<std::size_t> distributeInParallel(const Range& r, Digit digit) {
     return bucketBegin;
 }
 
+// Scatters a large range `r` (varying bits `varying`) into r.keyScratch/valueScratch by a top
+// digit wide enough for cache-sized buckets, then sorts every bucket in parallel with
+// sortBucket(bucket) (the bucket's keys sit in its scratch arrays).
+template <typename SortBucket>
+void distributeAndSortBuckets(const Range& r, std::uint64_t varying, SortBucket&& sortBucket) {
+    const Digit digit = highestDigit(
+        varying, std::max(static_cast<int>(std::bit_width(r.count)) - kLargeBucketBits, 1),
+        kLargeDigitMaxWidth);
+    const std::vector<std::size_t> bucketBegin = distributeInParallel(r, digit);
+    tbb::parallel_for(std::size_t{0}, bucketBegin.size() - 1, [&](std::size_t d) {
+        const std::size_t begin = bucketBegin[d];
+        const std::size_t size = bucketBegin[d + 1] - begin;
+        if (size > 0) {
+            sortBucket(r.sub(begin, size));
+        }
+    });
+}
+
 // Sorts from.keys/values into into.keys/values (same count); from's arrays serve as scratch.
 void sortInto(const Range& from, const Range& into) {
     const std::size_t count = from.count;
@@ -292,17 +310,9 @@ void sortInto(const Range& from, const Range& into) {
         copyOver();
         return;
     }
-    const Digit digit = highestDigit(
-        varying, std::max(static_cast<int>(std::bit_width(count)) - kLargeBucketBits, 1),
-        kLargeDigitMaxWidth);
-    const std::vector<std::size_t> bucketBegin = distributeInParallel(r, digit);
-    tbb::parallel_for(std::size_t{0}, bucketBegin.size() - 1, [&](std::size_t d) {
-        const std::size_t begin = bucketBegin[d];
-        const std::size_t size = bucketBegin[d + 1] - begin;
-        if (size > 0) {
-            sortInPlace(r.sub(begin, size).swapped());
-        }
-    });
+    // A bucket sits in `into`'s arrays now, which its in-place sort keeps it in.
+    distributeAndSortBuckets(r, varying,
+                             [](const Range& bucket) { sortInPlace(bucket.swapped()); });
 }
 
 // Sorts r.keys/values in place; r.keyScratch/valueScratch serve as scratch.
@@ -316,19 +326,9 @@ void sortInPlace(const Range& r) {
     if (varying == 0) {
         return;
     }
-    const Digit digit = highestDigit(
-        varying, std::max(static_cast<int>(std::bit_width(count)) - kLargeBucketBits, 1),
-        kLargeDigitMaxWidth);
-    const std::vector<std::size_t> bucketBegin = distributeInParallel(r, digit);
     // Each bucket now sits in the scratch arrays; sorting it writes it back into place.
-    tbb::parallel_for(std::size_t{0}, bucketBegin.size() - 1, [&](std::size_t d) {
-        const std::size_t begin = bucketBegin[d];
-        const std::size_t size = bucketBegin[d + 1] - begin;
-        if (size > 0) {
-            const Range bucket = r.sub(begin, size);
-            sortInto(bucket.swapped(), bucket);
-        }
-    });
+    distributeAndSortBuckets(r, varying,
+                             [](const Range& bucket) { sortInto(bucket.swapped(), bucket); });
 }
 
 } // namespace

@@ -7,8 +7,7 @@
 #include "hierarchy_builder.hpp"
 #include "hierarchy_model.hpp"
 #include "level_model.hpp"
-#include "morton_sorter.hpp"
-#include "scene_generator.hpp"
+#include "widget_test_support.hpp"
 
 #include <QAbstractItemModelTester>
 #include <QLocale>
@@ -92,30 +91,18 @@ void TestCutPanel::selectingANodeShowsItsDetailsAndEmitsIt() {
 }
 
 void TestCutPanel::selectionFollowsItsRowWhileABuildRuns() {
-    const GeneratedScene scene = generateScene(300'000, 9);
-    CloudInfo info;
-    info.pointCount = scene.points.size();
-    info.attributes = scene.points.attributes;
-    info.sourceBounds = scene.sourceBounds;
-    info.cube = scene.cube;
-    SortOptions sortOptions;
-    sortOptions.batchPoints = 10'000;
-    IncrementalMortonSorter sorter(info, sortOptions);
-    sorter.add(scene.points);
-    std::vector<std::pair<std::size_t, std::size_t>> ranges;
-    sorter.sortAndEmit([&](const SortedCloud&, std::size_t begin, std::size_t end) {
-        ranges.emplace_back(begin, end);
-    });
+    const test::SortedScene scene = test::sortGeneratedScene(300'000, 9);
+    const auto& ranges = scene.ranges;
     BuildOptions options;
     options.maxLevel = 7;
-    HierarchyBuilder builder(sorter.cloud(), options);
+    HierarchyBuilder builder(scene.cloud(), options);
     const auto hierarchy = builder.sharedHierarchy();
 
     CutPanel panel;
     panel.show();
     panel.setHierarchy(hierarchy);
     for (std::size_t i = 0; i < ranges.size() / 2; ++i) {
-        builder.onSortedRange(*sorter.cloud(), ranges[i].first, ranges[i].second);
+        builder.onSortedRange(*scene.cloud(), ranges[i].first, ranges[i].second);
     }
     HierarchyModel& model = *panel.hierarchyModel();
     QTRY_VERIFY_WITH_TIMEOUT((panel.refreshHierarchy(), model.rowCount() > 0), kTimeoutMs);
@@ -131,7 +118,7 @@ void TestCutPanel::selectionFollowsItsRowWhileABuildRuns() {
 
     std::thread producer([&] {
         for (std::size_t i = ranges.size() / 2; i < ranges.size(); ++i) {
-            builder.onSortedRange(*sorter.cloud(), ranges[i].first, ranges[i].second);
+            builder.onSortedRange(*scene.cloud(), ranges[i].first, ranges[i].second);
         }
         builder.finish();
     });

@@ -6,10 +6,9 @@
 #include "build_pipeline.hpp"
 #include "hierarchy_builder.hpp"
 #include "hierarchy_model.hpp"
-#include "morton_sorter.hpp"
 #include "omh_reader.hpp"
 #include "omh_writer.hpp"
-#include "scene_generator.hpp"
+#include "widget_test_support.hpp"
 
 #include <QAbstractItemModelTester>
 #include <QSignalSpy>
@@ -106,25 +105,13 @@ private slots:
 };
 
 void TestHierarchyModel::growsWithTheBuildAndPassesTheModelTester() {
-    const GeneratedScene scene = generateScene(300'000, 8);
-    CloudInfo info;
-    info.pointCount = scene.points.size();
-    info.attributes = scene.points.attributes;
-    info.sourceBounds = scene.sourceBounds;
-    info.cube = scene.cube;
-    SortOptions sortOptions;
-    sortOptions.batchPoints = 10'000;
-    IncrementalMortonSorter sorter(info, sortOptions);
-    sorter.add(scene.points);
-    std::vector<std::pair<std::size_t, std::size_t>> ranges;
-    sorter.sortAndEmit([&](const SortedCloud&, std::size_t begin, std::size_t end) {
-        ranges.emplace_back(begin, end);
-    });
+    const test::SortedScene scene = test::sortGeneratedScene(300'000, 8);
+    const auto& ranges = scene.ranges;
     QVERIFY(ranges.size() >= 10);
     BuildOptions options;
     options.maxLevel = 7;
     options.worklistSize = 16;
-    HierarchyBuilder builder(sorter.cloud(), options);
+    HierarchyBuilder builder(scene.cloud(), options);
     const auto hierarchy = builder.sharedHierarchy();
 
     HierarchyModel model;
@@ -138,7 +125,7 @@ void TestHierarchyModel::growsWithTheBuildAndPassesTheModelTester() {
 
     // Half the input: the builder cannot finish, and what it settles shows up.
     for (std::size_t i = 0; i < ranges.size() / 2; ++i) {
-        builder.onSortedRange(*sorter.cloud(), ranges[i].first, ranges[i].second);
+        builder.onSortedRange(*scene.cloud(), ranges[i].first, ranges[i].second);
     }
     QTRY_VERIFY_WITH_TIMEOUT((model.refresh(), model.rowCount() > 0), kTimeoutMs);
     QVERIFY(!hierarchy->publishedCut().complete);
@@ -158,7 +145,7 @@ void TestHierarchyModel::growsWithTheBuildAndPassesTheModelTester() {
     std::atomic<bool> fed{false};
     std::thread producer([&] {
         for (std::size_t i = ranges.size() / 2; i < ranges.size(); ++i) {
-            builder.onSortedRange(*sorter.cloud(), ranges[i].first, ranges[i].second);
+            builder.onSortedRange(*scene.cloud(), ranges[i].first, ranges[i].second);
         }
         builder.finish();
         fed.store(true);

@@ -12,6 +12,7 @@
 #include "level_model.hpp"
 #include "main_window.hpp"
 #include "time_series_chart.hpp"
+#include "widget_test_support.hpp"
 
 #include <QAbstractItemModelTester>
 #include <QAction>
@@ -34,18 +35,6 @@ using namespace omicron;
 
 namespace {
 constexpr int kBuildTimeoutMs = 120'000;
-
-// Pixels in the highlight's magenta (red and blue high, green low).
-int magentaPixels(const QImage& image) {
-    int count = 0;
-    for (int y = 0; y < image.height(); ++y) {
-        for (int x = 0; x < image.width(); ++x) {
-            const QColor c = image.pixelColor(x, y);
-            count += c.red() > 200 && c.blue() > 200 && c.green() < 80 ? 1 : 0;
-        }
-    }
-    return count;
-}
 
 // The level table's "Front nodes" column against the view's last frame: the same numbers,
 // adding up to the front's size.
@@ -299,20 +288,20 @@ void TestMainWindowGL::hierarchyTreeSelectionHighlightsTheNodeInTheView() {
     QVERIFY(delay->line(0)->points().last().y() <= delay->line(1)->points().last().y());
 
     CloudView* view = window.cloudView();
-    const int before = magentaPixels(view->grabFramebuffer());
+    const int before = test::magentaPixels(view->grabFramebuffer());
     const auto hierarchy = window.service()->hierarchy();
     const morton::Code code = hierarchy->node(1, 0).code;
     QVERIFY(panel->selectNode(code));
     QCOMPARE(view->highlightedNode(), std::optional<std::uint64_t>(code));
     QVERIFY(panel->nodeDetails().contains(QStringLiteral("0x%1").arg(code, 0, 16)));
-    const int highlighted = magentaPixels(view->grabFramebuffer());
+    const int highlighted = test::magentaPixels(view->grabFramebuffer());
     QVERIFY2(highlighted > before + 100,
              qPrintable(QStringLiteral("%1 -> %2").arg(before).arg(highlighted)));
 
     panel->hierarchyTree()->selectionModel()->clearCurrentIndex();
     QVERIFY(!panel->selectedNode());
     QVERIFY(!view->highlightedNode());
-    QCOMPARE(magentaPixels(view->grabFramebuffer()), before);
+    QCOMPARE(test::magentaPixels(view->grabFramebuffer()), before);
 }
 
 int main(int argc, char* argv[]) {

@@ -5,7 +5,6 @@
 #include "hierarchy_builder.hpp"
 #include "morton_sorter.hpp"
 #include "point_reader.hpp"
-#include "scene_generator.hpp"
 #include "widget_test_support.hpp"
 
 #include <QSignalSpy>
@@ -45,18 +44,6 @@ std::shared_ptr<const Hierarchy> generatedHierarchy(std::uint64_t points) {
     options.build.maxLevel = 7;
     pipeline.runGeneratedScene(points, 1, options);
     return pipeline.hierarchy();
-}
-
-// Pixels of `image` in the highlight's magenta (red and blue high, green low).
-int magentaPixels(const QImage& image) {
-    int count = 0;
-    for (int y = 0; y < image.height(); ++y) {
-        for (int x = 0; x < image.width(); ++x) {
-            const QColor c = image.pixelColor(x, y);
-            count += c.red() > 200 && c.blue() > 200 && c.green() < 80 ? 1 : 0;
-        }
-    }
-    return count;
 }
 
 } // namespace
@@ -164,14 +151,14 @@ private slots:
         view.setStandardView(StandardView::Iso);
         const QImage plain = view.renderImage(QSize(320, 240));
         QVERIFY2(!plain.isNull(), qPrintable(view.glErrorString()));
-        QCOMPARE(magentaPixels(plain), 0);
+        QCOMPARE(test::magentaPixels(plain), 0);
 
         QVERIFY(hierarchy->nodeCount(1) > 0);
         const std::uint64_t code = hierarchy->node(1, 0).code;
         view.setHighlightedNode(1, code);
         QCOMPARE(view.highlightedNode(), std::optional<std::uint64_t>(code));
         const QImage highlighted = view.renderImage(QSize(320, 240));
-        const int boxPixels = magentaPixels(highlighted);
+        const int boxPixels = test::magentaPixels(highlighted);
         // Twelve edges of a cell an eighth of the cloud's cube: well over a hundred pixels.
         QVERIFY2(boxPixels > 100, qPrintable(QString::number(boxPixels)));
         int changed = 0;
@@ -184,7 +171,7 @@ private slots:
 
         view.clearHighlightedNode();
         QVERIFY(!view.highlightedNode().has_value());
-        QCOMPARE(magentaPixels(view.renderImage(QSize(320, 240))), 0);
+        QCOMPARE(test::magentaPixels(view.renderImage(QSize(320, 240))), 0);
 
         // A code that is not of the given level clears the highlight.
         view.setHighlightedNode(1, code);
@@ -197,25 +184,13 @@ private slots:
     // leaf the builder logs after the view attached is counted exactly once over the frames,
     // each frame with its median below its maximum.
     void leafDrawDelayIsMeasuredWhileABuildRuns() {
-        const GeneratedScene scene = generateScene(150'000, 4);
-        CloudInfo info;
-        info.pointCount = scene.points.size();
-        info.attributes = scene.points.attributes;
-        info.sourceBounds = scene.sourceBounds;
-        info.cube = scene.cube;
-        SortOptions sortOptions;
-        sortOptions.batchPoints = 10'000;
-        IncrementalMortonSorter sorter(info, sortOptions);
-        sorter.add(scene.points);
-        std::vector<std::pair<std::size_t, std::size_t>> ranges;
-        sorter.sortAndEmit([&](const SortedCloud&, std::size_t begin, std::size_t end) {
-            ranges.emplace_back(begin, end);
-        });
+        const test::SortedScene scene = test::sortGeneratedScene(150'000, 4);
+        const auto& ranges = scene.ranges;
         QVERIFY(ranges.size() >= 8);
 
         BuildOptions options;
         options.maxLevel = 7;
-        HierarchyBuilder builder(sorter.cloud(), options);
+        HierarchyBuilder builder(scene.cloud(), options);
         CloudView view;
         view.setRenderSettings(plainSettings());
         view.setHierarchy(builder.sharedHierarchy()); // before the first leaf is published
@@ -241,7 +216,7 @@ private slots:
             count(view.lastFrameStats());
         };
         for (const auto& [begin, end] : ranges) {
-            builder.onSortedRange(*sorter.cloud(), begin, end);
+            builder.onSortedRange(*scene.cloud(), begin, end);
             frame();
         }
         builder.finish();
@@ -288,12 +263,14 @@ private slots:
         for (std::size_t i = 0; i < ranges.size(); ++i) {
             builder.onSortedRange(*sorter.cloud(), ranges[i].first, ranges[i].second);
             if (i % step == step - 1) {
-                coverages.push_back(test::coverage(view.renderImage(QSize(200, 200)), test::viewBackground()));
+                coverages.push_back(
+                    test::coverage(view.renderImage(QSize(200, 200)), test::viewBackground()));
             }
         }
         builder.finish();
         builder.wait();
-        coverages.push_back(test::coverage(view.renderImage(QSize(200, 200)), test::viewBackground()));
+        coverages.push_back(
+            test::coverage(view.renderImage(QSize(200, 200)), test::viewBackground()));
         QString trace;
         for (double c : coverages) {
             trace += QString::number(c, 'f', 4) + " ";

@@ -1,6 +1,7 @@
 #include "widget_test_support.hpp"
 
 #include "build_pipeline.hpp"
+#include "scene_generator.hpp"
 
 #include <QFileInfo>
 #include <cstdlib>
@@ -16,6 +17,35 @@ std::shared_ptr<const Hierarchy> buildHierarchy(const QString& path, const Build
     BuildPipeline pipeline;
     pipeline.run(path.toStdString(), {options, kDefaultSortChunks});
     return pipeline.hierarchy();
+}
+
+SortedScene sortGeneratedScene(std::size_t points, std::uint64_t seed, std::size_t rangePoints) {
+    const GeneratedScene scene = generateScene(points, seed);
+    CloudInfo info;
+    info.pointCount = scene.points.size();
+    info.attributes = scene.points.attributes;
+    info.sourceBounds = scene.sourceBounds;
+    info.cube = scene.cube;
+    SortOptions sortOptions;
+    sortOptions.batchPoints = rangePoints;
+    SortedScene sorted;
+    sorted.sorter = std::make_unique<IncrementalMortonSorter>(info, sortOptions);
+    sorted.sorter->add(scene.points);
+    sorted.sorter->sortAndEmit([&](const SortedCloud&, std::size_t begin, std::size_t end) {
+        sorted.ranges.emplace_back(begin, end);
+    });
+    return sorted;
+}
+
+int magentaPixels(const QImage& image) {
+    int count = 0;
+    for (int y = 0; y < image.height(); ++y) {
+        for (int x = 0; x < image.width(); ++x) {
+            const QColor c = image.pixelColor(x, y);
+            count += c.red() > 200 && c.blue() > 200 && c.green() < 80 ? 1 : 0;
+        }
+    }
+    return count;
 }
 
 double coverage(const QImage& image, const QColor& background) {
@@ -35,6 +65,8 @@ double coverage(const QImage& image, const QColor& background) {
     return static_cast<double>(covered) / std::max(1, rgb.width() * rgb.height());
 }
 
-QColor viewBackground() { return QColor::fromRgbF(0.11f, 0.12f, 0.14f); }
+QColor viewBackground() {
+    return QColor::fromRgbF(0.11f, 0.12f, 0.14f);
+}
 
 } // namespace omicron::test

@@ -1,13 +1,18 @@
-// Helpers of the widget tests: shared data paths, finished hierarchies, image statistics.
+// Helpers of the widget tests (and of the application's GL tests): shared data paths,
+// finished hierarchies, a generated scene sorted into ranges, image statistics.
 #pragma once
 
 #include "build_options.hpp"
 #include "hierarchy.hpp"
+#include "morton_sorter.hpp"
 
 #include <QColor>
 #include <QImage>
 #include <QString>
+#include <cstdint>
 #include <memory>
+#include <utility>
+#include <vector>
 
 namespace omicron::test {
 
@@ -16,6 +21,19 @@ QString sharedDataFile(const char* name);
 
 // Reads, sorts and builds `path` completely (pipeline 1), like the application does.
 std::shared_ptr<const Hierarchy> buildHierarchy(const QString& path, const BuildOptions& options);
+
+// The built-in generated scene, sorted by the real incremental sorter in ranges of
+// `rangePoints`: a test feeds the ranges to a HierarchyBuilder at its own pace.
+struct SortedScene {
+    std::unique_ptr<IncrementalMortonSorter> sorter;
+    std::vector<std::pair<std::size_t, std::size_t>> ranges;
+    std::shared_ptr<const SortedCloud> cloud() const { return sorter->cloud(); }
+};
+SortedScene sortGeneratedScene(std::size_t points, std::uint64_t seed,
+                               std::size_t rangePoints = 10'000);
+
+// Pixels of `image` in the node highlight's magenta (red and blue high, green low).
+int magentaPixels(const QImage& image);
 
 // Fraction of pixels of `image` that differ from `background` (the cloud's coverage).
 double coverage(const QImage& image, const QColor& background);
