@@ -3,6 +3,7 @@
 #include "build_panel.hpp"
 #include "builder_service.hpp"
 #include "charts_panel.hpp"
+#include "cloud_view.hpp"
 #include "cut_panel.hpp"
 #include "process_memory.hpp"
 #include "ui_mainwindow.h"
@@ -25,8 +26,6 @@
 #include <QSettings>
 #include <QUrl>
 
-#include "cloud_view.hpp"
-
 namespace omicron {
 
 namespace {
@@ -47,6 +46,7 @@ MainWindow::MainWindow(QWidget* parent)
     m_phaseLabel = new QLabel(this);
     m_pointsLabel = new QLabel(this);
     m_fpsLabel = new QLabel(this);
+    m_fpsLabel->setObjectName(QStringLiteral("fpsLabel"));
     m_memoryLabel = new QLabel(this);
     m_progressBar = new QProgressBar(this);
     m_progressBar->setMaximum(1000);
@@ -55,7 +55,8 @@ MainWindow::MainWindow(QWidget* parent)
     m_progressBar->hide();
     m_phaseLabel->setToolTip(tr("Build phase"));
     m_pointsLabel->setToolTip(tr("Points drawn in the last frame / points of the cloud"));
-    m_fpsLabel->setToolTip(tr("Frames per second"));
+    m_fpsLabel->setToolTip(tr("Frames per second while the view draws; \"idle\" when nothing "
+                              "changed (frames are drawn on demand)"));
     m_memoryLabel->setToolTip(tr("Resident memory of the process"));
     statusBar()->addPermanentWidget(m_progressBar);
     statusBar()->addPermanentWidget(m_phaseLabel);
@@ -254,6 +255,7 @@ void MainWindow::connectActions() {
         m_cutPanel->setFrontNodes(stats.frontNodesPerLevel);
         m_pointsDrawn = stats.pointsDrawn;
         m_fps = stats.fps;
+        m_lastFrame.start();
     });
 }
 
@@ -483,7 +485,11 @@ void MainWindow::updateStatus() {
     m_pointsLabel->setText(tr("%1 / %2 points")
                                .arg(locale.toString(quint64(m_pointsDrawn)),
                                     locale.toString(quint64(m_progress.pointsTotal))));
-    m_fpsLabel->setText(tr("%1 fps").arg(m_fps, 0, 'f', 1));
+    // The view draws on demand: with nothing changing for a while it is idle, not slow.
+    constexpr qint64 kIdleMs = 1500;
+    m_fpsLabel->setText(m_lastFrame.isValid() && m_lastFrame.elapsed() < kIdleMs
+                            ? tr("%1 fps").arg(m_fps, 0, 'f', 1)
+                            : tr("idle"));
     m_memoryLabel->setText(mib(residentBytes()));
 }
 

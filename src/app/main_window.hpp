@@ -8,6 +8,7 @@
 #include "build_pipeline.hpp"
 #include "view_parameters.hpp"
 
+#include <QElapsedTimer>
 #include <QMainWindow>
 #include <QStringList>
 #include <QTimer>
@@ -95,6 +96,7 @@ private:
     QTimer m_statusTimer;
     std::size_t m_pointsDrawn = 0;
     double m_fps = 0.0;
+    QElapsedTimer m_lastFrame; // since the view's last frame
 };
 
 } // namespace omicron

@@ -17,8 +17,8 @@
 #include <QWheelEvent>
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <glm/gtc/matrix_inverse.hpp>
+#include <limits>
 #include <optional>
 
 namespace omicron {
@@ -48,7 +48,8 @@ public:
     QSet<int> flyKeys;
     QTimer frameTimer;
     QElapsedTimer flyClock;
-    QElapsedTimer fpsClock;
+    QElapsedTimer fpsClock;   // start of the current fps window
+    QElapsedTimer frameClock; // since the last frame drawn
     int framesThisSecond = 0;
     double fps = 0.0;
     QPoint lastMouse;
@@ -87,7 +88,8 @@ public:
     }
 };
 
-CloudView::CloudView(QWidget* parent) : QOpenGLWidget(parent), d(std::make_unique<CloudViewPrivate>()) {
+CloudView::CloudView(QWidget* parent)
+    : QOpenGLWidget(parent), d(std::make_unique<CloudViewPrivate>()) {
     qRegisterMetaType<omicron::FrameStats>();
     qRegisterMetaType<omicron::RenderSettings>();
     QSurfaceFormat surfaceFormat = format();
@@ -135,7 +137,9 @@ void CloudView::setHierarchy(std::shared_ptr<const Hierarchy> hierarchy) {
     update();
 }
 
-std::shared_ptr<const Hierarchy> CloudView::hierarchy() const { return d->cloud->hierarchy(); }
+std::shared_ptr<const Hierarchy> CloudView::hierarchy() const {
+    return d->cloud->hierarchy();
+}
 
 void CloudView::setPreview(const PreviewSample& preview, const CubeTransform& cube) {
     (void)cube; // preview positions are already in the unit cube of `cube`
@@ -148,7 +152,8 @@ void CloudView::setPreview(const PreviewSample& preview, const CubeTransform& cu
     // A preview point stands for pointsSeen / samples input points: size its splat so the
     // sample covers the area the cloud would (a surface of the box's two largest extents).
     const glm::vec3 extent = glm::max(high - low, glm::vec3(0.0f));
-    const float area = std::max({extent.x * extent.y, extent.x * extent.z, extent.y * extent.z, 1e-12f});
+    const float area =
+        std::max({extent.x * extent.y, extent.x * extent.z, extent.y * extent.z, 1e-12f});
     const float radius =
         vertices.empty() ? 0.0f : 0.6f * std::sqrt(area / static_cast<float>(vertices.size()));
     for (std::size_t i = 0; i < vertices.size(); ++i) {
@@ -174,7 +179,9 @@ void CloudView::clearPreview() {
     update();
 }
 
-RenderSettings CloudView::renderSettings() const { return d->settings; }
+RenderSettings CloudView::renderSettings() const {
+    return d->settings;
+}
 
 void CloudView::setRenderSettings(const RenderSettings& settings) {
     if (settings == d->settings) {
@@ -185,7 +192,9 @@ void CloudView::setRenderSettings(const RenderSettings& settings) {
     update();
 }
 
-ViewCamera CloudView::camera() const { return d->camera; }
+ViewCamera CloudView::camera() const {
+    return d->camera;
+}
 
 void CloudView::setCamera(const ViewCamera& camera) {
     d->camera = camera;
@@ -216,7 +225,9 @@ void CloudView::setFlyMode(bool on) {
     emit flyModeChanged(on);
 }
 
-bool CloudView::flyMode() const { return d->flyMode; }
+bool CloudView::flyMode() const {
+    return d->flyMode;
+}
 
 void CloudView::setHighlightedNode(int level, std::uint64_t code) {
     if (!morton::isValid(code) || morton::level(code) != level) {
@@ -242,11 +253,17 @@ std::optional<std::uint64_t> CloudView::highlightedNode() const {
     return d->overlay->highlight();
 }
 
-FrameStats CloudView::lastFrameStats() const { return d->lastStats; }
+FrameStats CloudView::lastFrameStats() const {
+    return d->lastStats;
+}
 
-QString CloudView::glErrorString() const { return d->glError; }
+QString CloudView::glErrorString() const {
+    return d->glError;
+}
 
-QString CloudView::glRendererName() const { return d->glRenderer; }
+QString CloudView::glRendererName() const {
+    return d->glRenderer;
+}
 
 bool CloudView::computePointsAvailable() const {
     return d->glReady && d->cloud->computePointsAvailable();
@@ -301,7 +318,8 @@ FrameStats CloudView::renderFrame(unsigned framebuffer, int widthPx, int heightP
         return stats;
     }
     // Bounded work per frame while a build publishes points; everything for a screenshot.
-    d->cloud->updateBounds(settle ? std::numeric_limits<std::size_t>::max() : kBoundsPointsPerFrame);
+    d->cloud->updateBounds(settle ? std::numeric_limits<std::size_t>::max()
+                                  : kBoundsPointsPerFrame);
     d->applyAutoFit();
     if (d->cloud->hasBounds()) {
         d->camera.setSceneBox(d->cloud->boundsMin(), d->cloud->boundsMax());
@@ -343,6 +361,13 @@ void CloudView::paintGL() {
     const int heightPx = std::max(1, static_cast<int>(std::lround(height() * ratio)));
     FrameStats stats = renderFrame(defaultFramebufferObject(), widthPx, heightPx, false);
 
+    // Frames are drawn on demand: after a pause (no input, nothing to refine) a new window
+    // starts with this frame, so the rate is that of rendering, not diluted by the idle time.
+    constexpr qint64 kIdleMs = 1000;
+    if (!d->frameClock.isValid() || d->frameClock.restart() > kIdleMs) {
+        d->framesThisSecond = 0;
+        d->fpsClock.restart();
+    }
     ++d->framesThisSecond;
     const qint64 elapsedMs = d->fpsClock.elapsed();
     if (elapsedMs >= 1000) {
@@ -415,8 +440,9 @@ std::optional<QVector3D> CloudView::pickPoint(const QPoint& position) {
     const double py = y0 + static_cast<double>(best / static_cast<std::size_t>(w)) + 0.5;
     const glm::dvec4 ndc(px / widthPx * 2.0 - 1.0, py / heightPx * 2.0 - 1.0,
                          depths[best] * 2.0 - 1.0, 1.0);
-    const glm::dmat4 inverse = glm::inverse(
-        d->camera.projectionMatrix(static_cast<double>(widthPx) / heightPx) * d->camera.viewMatrix());
+    const glm::dmat4 inverse =
+        glm::inverse(d->camera.projectionMatrix(static_cast<double>(widthPx) / heightPx) *
+                     d->camera.viewMatrix());
     const glm::dvec4 world = inverse * ndc;
     return QVector3D(static_cast<float>(world.x / world.w), static_cast<float>(world.y / world.w),
                      static_cast<float>(world.z / world.w));
@@ -427,14 +453,17 @@ void CloudView::mousePressEvent(QMouseEvent* event) {
     d->dragButtons = event->buttons();
 }
 
-void CloudView::mouseReleaseEvent(QMouseEvent* event) { d->dragButtons = event->buttons(); }
+void CloudView::mouseReleaseEvent(QMouseEvent* event) {
+    d->dragButtons = event->buttons();
+}
 
 void CloudView::mouseMoveEvent(QMouseEvent* event) {
     const QPoint position = event->position().toPoint();
     const QPoint delta = position - d->lastMouse;
     d->lastMouse = position;
-    const bool panning = (event->buttons() & (Qt::RightButton | Qt::MiddleButton)) ||
-                         ((event->buttons() & Qt::LeftButton) && (event->modifiers() & Qt::ShiftModifier));
+    const bool panning =
+        (event->buttons() & (Qt::RightButton | Qt::MiddleButton)) ||
+        ((event->buttons() & Qt::LeftButton) && (event->modifiers() & Qt::ShiftModifier));
     if (panning) {
         d->camera.pan(delta.x(), delta.y(), height());
     } else if (event->buttons() & Qt::LeftButton) {
@@ -466,8 +495,8 @@ void CloudView::wheelEvent(QWheelEvent* event) {
     const double factor = std::pow(kWheelZoomPerNotch, notches);
     // Zoom to the point under the cursor; over empty space, towards the pivot.
     const auto picked = pickPoint(event->position().toPoint());
-    const glm::dvec3 target = picked ? glm::dvec3(picked->x(), picked->y(), picked->z())
-                                     : d->camera.pivot();
+    const glm::dvec3 target =
+        picked ? glm::dvec3(picked->x(), picked->y(), picked->z()) : d->camera.pivot();
     d->camera.zoomToward(target, factor);
     d->autoFit = false;
     update();

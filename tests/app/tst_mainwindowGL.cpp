@@ -21,6 +21,7 @@
 #include <QFile>
 #include <QFileInfo>
 #include <QImage>
+#include <QLabel>
 #include <QLineSeries>
 #include <QMessageBox>
 #include <QSettings>
@@ -108,6 +109,13 @@ void TestMainWindowGL::openingASharedFileBuildsAndFillsThePanels() {
         QTRY_VERIFY_WITH_TIMEOUT(frontColumnMatchesTheView(window), kBuildTimeoutMs);
         QCOMPARE(window.cutPanel()->hierarchyModel()->rowCount(), 1);
         QCOMPARE(window.cutPanel()->hierarchyModel()->hierarchy(), window.service()->hierarchy());
+        // With nothing left to refine the view stops drawing: the status bar says so rather
+        // than an fps diluted by the pause; the next frame shows a rate again.
+        auto* fpsLabel = window.findChild<QLabel*>(QStringLiteral("fpsLabel"));
+        QVERIFY(fpsLabel != nullptr);
+        QTRY_COMPARE_WITH_TIMEOUT(fpsLabel->text(), QStringLiteral("idle"), kBuildTimeoutMs);
+        window.cloudView()->update();
+        QTRY_VERIFY(fpsLabel->text().endsWith(QStringLiteral(" fps")));
 
         // Rebuild from the panel: no re-read, a deeper table.
         BuilderService* service = window.service();
