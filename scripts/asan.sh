@@ -4,8 +4,10 @@
 # preset (ASan + UBSan, invariant checkers on) for the tests of cancelling and closing while a
 # build runs, and runs them under Xvfb with leak detection: tst_builderservice (cancel, also
 # during a file's bounds pre-pass; destruction mid-build), tst_mainwindowGL (close mid-build,
-# open, rebuild, save, errors), and the hierarchy tree's tests, which read a hierarchy while a
-# builder grows it (tst_hierarchymodel, tst_cutpanel). Any leak or memory error fails the job;
+# open, rebuild, save, errors), the hierarchy tree's tests, which read a hierarchy while a
+# builder grows it (tst_hierarchymodel, tst_cutpanel), and the viewer's GL tests (node packing
+# in parallel, the compute rasterizer's tables; tst_cloudview_gl, tst_computepoints_gl). Any
+# leak or memory error fails the job;
 # the suppressions in scripts/lsan.supp cover third-party libraries only.
 # Extra arguments replace the default test list, e.g. ./scripts/asan.sh tst_builderservice.
 set -euo pipefail
@@ -14,7 +16,8 @@ source scripts/common.sh
 omicron_install_packages
 
 tests=("$@")
-[ "${#tests[@]}" -eq 0 ] && tests=(tst_builderservice tst_mainwindowGL tst_hierarchymodel tst_cutpanel)
+[ "${#tests[@]}" -eq 0 ] && tests=(tst_builderservice tst_mainwindowGL tst_hierarchymodel tst_cutpanel
+  tst_cloudview_gl tst_computepoints_gl)
 
 cmake --preset asan >/dev/null
 cmake --build --preset asan --target "${tests[@]}"

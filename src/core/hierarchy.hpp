@@ -130,6 +130,10 @@ public:
     std::size_t appendNode(int level, const OctreeNode& node);
     std::size_t builtNodeCount(int level) const { return m_levels[level]->nodes.size(); }
     std::uint32_t* allocateSamples(std::size_t count) { return m_samples.allocate(count); }
+    // Keeps a buffer of samples a worker filled (no copy); returns where its elements now live.
+    const std::uint32_t* adoptSamples(std::vector<std::uint32_t>&& samples) {
+        return m_samples.adopt(std::move(samples));
+    }
     StoredSplats& mutableStoredSplats() { return *m_storedSplats; } // SplatSource::Stored only
 
     void publishNodes(int level);

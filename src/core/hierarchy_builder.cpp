@@ -36,10 +36,14 @@ struct ParentDraft {
 
 struct WorklistResult {
     std::vector<ParentDraft> drafts;
+    // The drafts' samples. The commit hands the whole buffer to the hierarchy (no copy on
+    // the master thread), so the worker trims it to size first.
     std::vector<std::uint32_t> samples;
+    const std::uint32_t* adoptedSamples = nullptr; // where the hierarchy keeps them
     void clear() {
         drafts.clear();
         samples.clear();
+        adoptedSamples = nullptr;
     }
 };
 
@@ -116,7 +120,7 @@ public:
     tbb::task_arena arena;
     std::vector<WorklistResult> results;
     WorklistResult merged;
-    std::vector<std::pair<const WorklistResult*, std::size_t>> order;
+    std::vector<std::pair<WorklistResult*, std::size_t>> order;
     std::vector<LeafRun> runs;
     std::vector<std::uint32_t> groupOf;  // run -> its sibling group
     std::vector<std::size_t> groupFirst; // group -> its first run (+ one past the last)
@@ -372,6 +376,7 @@ void HierarchyBuilder::fixLevel(int level) {
         forEachSiblingGroup(slice, [&](std::span<const CutRoot> group) {
             draftParent(*m_hierarchy, m_cut, m_options, level - 1, group, result);
         });
+        result.samples.shrink_to_fit();
     };
     if (worklists == 1) {
         runWorklist(0);
@@ -393,7 +398,7 @@ void HierarchyBuilder::fixLevel(int level) {
     auto& order = worker.order;
     order.clear();
     for (std::size_t w = 0; w < worklists; ++w) {
-        const WorklistResult& result = worker.results[w];
+        WorklistResult& result = worker.results[w];
         for (std::size_t d = 0; d < result.drafts.size(); ++d) {
             const morton::Code code = result.drafts[d].code();
             if (order.empty() || order.back().first->drafts[order.back().second].code() != code) {
@@ -419,6 +424,7 @@ void HierarchyBuilder::fixLevel(int level) {
     std::vector<CutRoot>& parents = worker.roots;
     parents.clear();
     LevelStatistics& parentLevel = m_stats.levels[level - 1];
+    worker.merged.samples.shrink_to_fit();
     for (const auto& [result, d] : order) {
         const ParentDraft& draft = result->drafts[d];
         if (draft.risingPlaceholder) {
@@ -427,9 +433,11 @@ void HierarchyBuilder::fixLevel(int level) {
         }
         OctreeNode node = draft.node;
         if (draft.sampled) {
-            std::uint32_t* samples = m_hierarchy->allocateSamples(node.pointCount);
-            std::copy_n(result->samples.begin() + draft.sampleOffset, node.pointCount, samples);
-            node.sampleIndices = samples;
+            if (result->adoptedSamples == nullptr) {
+                // The result is not reused before the next level: its buffer may move out.
+                result->adoptedSamples = m_hierarchy->adoptSamples(std::move(result->samples));
+            }
+            node.sampleIndices = result->adoptedSamples + draft.sampleOffset;
         }
         parents.push_back({node.code,
                            static_cast<std::uint32_t>(m_hierarchy->appendNode(level - 1, node)),

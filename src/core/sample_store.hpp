@@ -1,8 +1,10 @@
 // Storage for the point samples of parents: contiguous uint32 runs that never move.
 //
-// A bump allocator over large blocks. Nodes keep a raw pointer to their run, so a block is
-// never resized or freed while the store lives; the tail of a block that cannot fit the next
-// run is left unused (at most one run's worth per block).
+// A bump allocator over large blocks, and buffers adopted whole from the builder's workers
+// (their samples, drafted in parallel, are kept where they were written instead of being
+// copied by the one master thread). Nodes keep a raw pointer to their run, so a block or
+// buffer is never resized or freed while the store lives; the tail of a block that cannot fit
+// the next run is left unused (at most one run's worth per block).
 #pragma once
 
 #include "huge_page_buffer.hpp"
@@ -31,10 +33,18 @@ public:
         return run;
     }
 
+    // One writer thread. Keeps `samples` (moving a vector keeps its elements in place).
+    const std::uint32_t* adopt(std::vector<std::uint32_t>&& samples) {
+        m_bytesAllocated += samples.capacity() * sizeof(std::uint32_t);
+        m_adopted.push_back(std::move(samples));
+        return m_adopted.back().data();
+    }
+
     std::size_t bytesAllocated() const { return m_bytesAllocated; }
 
 private:
     std::vector<HugePageArray<std::uint32_t>> m_blocks;
+    std::vector<std::vector<std::uint32_t>> m_adopted;
     std::size_t m_blockCapacity = 0;
     std::size_t m_used = 0;
     std::size_t m_bytesAllocated = 0;

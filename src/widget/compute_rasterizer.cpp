@@ -184,12 +184,17 @@ void ComputeRasterizer::buildTables(const std::vector<Batch>& batches) {
 }
 
 void ComputeRasterizer::uploadTables(QOpenGLExtraFunctions& gl) {
-    // Fresh storage each frame (orphaning): the driver need not wait for the last frame.
+    // Fresh storage each frame (orphaning): the driver need not wait for the last frame. The
+    // storage is never smaller than 16 bytes (an empty buffer texture is invalid), so the data
+    // goes in separately: handing glBufferData a 4-byte table for 16 bytes would read past it.
     const auto upload = [&](unsigned buffer, const void* data, std::size_t bytes) {
         gl.glBindBuffer(GL_TEXTURE_BUFFER, buffer);
         gl.glBufferData(GL_TEXTURE_BUFFER,
-                        static_cast<GLsizeiptr>(std::max<std::size_t>(bytes, 16)),
-                        bytes > 0 ? data : nullptr, GL_STREAM_DRAW);
+                        static_cast<GLsizeiptr>(std::max<std::size_t>(bytes, 16)), nullptr,
+                        GL_STREAM_DRAW);
+        if (bytes > 0) {
+            gl.glBufferSubData(GL_TEXTURE_BUFFER, 0, static_cast<GLsizeiptr>(bytes), data);
+        }
     };
     upload(m_drawNodeBuffer, m_drawNodes.data(), m_drawNodes.size() * sizeof(DrawNode));
     upload(m_chunkBuffer, m_chunkFirstNode.data(), m_chunkFirstNode.size() * sizeof(std::uint32_t));
