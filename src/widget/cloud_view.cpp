@@ -364,7 +364,11 @@ void CloudView::paintGL() {
     // Frames are drawn on demand: after a pause (no input, nothing to refine) a new window
     // starts with this frame, so the rate is that of rendering, not diluted by the idle time.
     constexpr qint64 kIdleMs = 1000;
-    if (!d->frameClock.isValid() || d->frameClock.restart() > kIdleMs) {
+    const qint64 sinceLastFrameMs = d->frameClock.isValid() ? d->frameClock.restart() : kIdleMs + 1;
+    if (!d->frameClock.isValid()) {
+        d->frameClock.start();
+    }
+    if (sinceLastFrameMs > kIdleMs) {
         d->framesThisSecond = 0;
         d->fpsClock.restart();
     }

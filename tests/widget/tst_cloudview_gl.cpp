@@ -7,6 +7,7 @@
 #include "point_reader.hpp"
 #include "widget_test_support.hpp"
 
+#include <QElapsedTimer>
 #include <QSignalSpy>
 #include <QtTest>
 #include <cmath>
@@ -183,6 +184,31 @@ private slots:
     // The front insertion delay (leaf published -> first drawn) through a real build: every
     // leaf the builder logs after the view attached is counted exactly once over the frames,
     // each frame with its median below its maximum.
+    // Frames are drawn on demand: the rate is measured over frames drawn back to back, and a
+    // frame after a pause starts a new window instead of reporting the pause as a low rate.
+    void framesPerSecondIgnoreIdlePauses() {
+        CloudView view;
+        view.resize(160, 120);
+        view.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&view));
+        const auto drawFor = [&](qint64 ms) {
+            QElapsedTimer clock;
+            clock.start();
+            while (clock.elapsed() < ms) {
+                view.repaint();
+                QCoreApplication::processEvents();
+            }
+        };
+        drawFor(1300);
+        const double drawing = view.lastFrameStats().fps;
+        QVERIFY2(drawing > 2.0, qPrintable(QString::number(drawing)));
+        QTest::qWait(2200); // idle: no frame
+        view.repaint();
+        QCOMPARE(view.lastFrameStats().fps, drawing);
+        drawFor(1300);
+        QVERIFY(view.lastFrameStats().fps > 2.0);
+    }
+
     void leafDrawDelayIsMeasuredWhileABuildRuns() {
         const test::SortedScene scene = test::sortGeneratedScene(150'000, 4);
         const auto& ranges = scene.ranges;
