@@ -50,6 +50,13 @@ void BuilderService::openGeneratedScene(std::uint64_t points, std::uint64_t seed
     submit(m_openJob(m_options));
 }
 
+QString BuilderService::sourceTitle() const {
+    const auto source = m_pipeline->source();
+    return source && !source->path.empty()
+               ? QFileInfo(QString::fromStdString(source->path)).fileName()
+               : tr("generated scene");
+}
+
 bool BuilderService::rebuild(const BuildOptions& options) {
     m_options.build = options;
     // While the cloud is still being read or sorted (or its run was cancelled) there is no
@@ -67,11 +74,7 @@ bool BuilderService::rebuild(const BuildOptions& options) {
         submit(m_openJob(m_options));
         return true;
     }
-    const auto source = m_pipeline->source();
-    const QString title = source && !source->path.empty()
-                              ? QFileInfo(QString::fromStdString(source->path)).fileName()
-                              : tr("generated scene");
-    submit({title,
+    submit({sourceTitle(),
             true,
             [options](BuildPipeline& pipeline) {
                 return JobOutcome{pipeline.rebuild(options), {}};
@@ -90,7 +93,9 @@ bool BuilderService::exportSortedStream(const QString& path) {
 bool BuilderService::exportPoints(const QString& path) {
     return submitCloudExport(path, [](const std::string& file, const SortedCloud& cloud) {
         exportCloudPoints(file, cloud);
-        return tr("Exported %1 points to %2").arg(cloud.sortedEnd()).arg(QString::fromStdString(file));
+        return tr("Exported %1 points to %2")
+            .arg(cloud.sortedEnd())
+            .arg(QString::fromStdString(file));
     });
 }
 
@@ -119,7 +124,8 @@ bool BuilderService::saveHierarchy(const QString& path) {
         return false;
     }
     const std::string file = path.toStdString();
-    const omh::BuildInfo info = omhBuildInfo(m_pipeline->hierarchyOptions(), m_pipeline->statistics());
+    const omh::BuildInfo info =
+        omhBuildInfo(m_pipeline->hierarchyOptions(), m_pipeline->statistics());
     submit({QFileInfo(path).fileName(), false,
             [file, hierarchy, info, path](BuildPipeline&) {
                 writeOmh(file, *hierarchy, info); // temporary file + rename: no partial file

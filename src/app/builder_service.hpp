@@ -67,6 +67,8 @@ public:
     const BuildPipeline& pipeline() const { return *m_pipeline; }
     std::shared_ptr<const Hierarchy> hierarchy() const { return m_pipeline->hierarchy(); }
     std::optional<PipelineSource> source() const { return m_pipeline->source(); }
+    // How the kept source is named to the user: its file name, or "generated scene".
+    QString sourceTitle() const;
     bool hasCompleteCloud() const { return m_pipeline->hasCompleteCloud(); }
     // Files (or scenes) read so far: a rebuild reads none.
     std::uint64_t sourceReads() const { return m_pipeline->sourceReads(); }

@@ -65,11 +65,7 @@ void CutPanel::setHierarchy(std::shared_ptr<const Hierarchy> hierarchy) {
     m_refreshing = true;
     m_hierarchy->setHierarchy(std::move(hierarchy));
     m_refreshing = false;
-    if (m_selected) {
-        m_selected.reset();
-        showNoSelection();
-        emit nodeSelectionCleared();
-    }
+    clearSelection();
 }
 
 void CutPanel::refreshHierarchy() {
@@ -85,9 +81,7 @@ void CutPanel::refreshHierarchy() {
         // The selected row went to the top of its parent, which settled: select it there.
         const morton::Code code = *m_selected;
         if (!selectNode(code)) {
-            m_selected.reset();
-            showNoSelection();
-            emit nodeSelectionCleared();
+            clearSelection();
         }
     }
 }
@@ -109,11 +103,7 @@ void CutPanel::onCurrentNodeChanged(const QModelIndex& current) {
     }
     const auto node = m_hierarchy->node(current);
     if (!node) {
-        if (m_selected) {
-            m_selected.reset();
-            showNoSelection();
-            emit nodeSelectionCleared();
-        }
+        clearSelection();
         return;
     }
     const Hierarchy& hierarchy = *m_hierarchy->hierarchy();
@@ -123,6 +113,15 @@ void CutPanel::onCurrentNodeChanged(const QModelIndex& current) {
         m_selected = code;
         emit nodeSelected(node->level, code);
     }
+}
+
+void CutPanel::clearSelection() {
+    if (!m_selected) {
+        return;
+    }
+    m_selected.reset();
+    showNoSelection();
+    emit nodeSelectionCleared();
 }
 
 void CutPanel::showNoSelection() {
@@ -172,11 +171,11 @@ int CutPanel::barValue(int bar) const {
 }
 
 void CutPanel::setProgress(const PipelineProgress& progress) {
-    m_ui->phaseLabel->setText(progress.phase == BuildPhase::Opening && progress.bytesToScan > 0
+    m_ui->phaseLabel->setText(progress.scanningBounds()
                                   ? tr("opening: scanning the file for its bounds")
                                   : QString::fromLatin1(toString(progress.phase)));
     const std::uint64_t total = progress.pointsTotal;
-    if (progress.phase == BuildPhase::Opening && progress.bytesToScan > 0) {
+    if (progress.scanningBounds()) {
         // PLY and XYZ files are read once for their bounds before any point streams.
         m_ui->readBar->setValue(permille(progress.bytesScanned, progress.bytesToScan));
         m_ui->readBar->setFormat(tr("scanning bounds: %1 / %2 MiB")

@@ -66,6 +66,8 @@ signals:
 private:
     void onCurrentNodeChanged(const QModelIndex& current);
     void showNoSelection();
+    // Forgets the selected node (if any) and tells the view.
+    void clearSelection();
 
     std::unique_ptr<Ui::CutPanel> m_ui;
     LevelModel* m_levels = nullptr;

@@ -1,5 +1,7 @@
 #include "hierarchy_model.hpp"
 
+#include "front_projection.hpp"
+
 #include <QLocale>
 #include <QScopedValueRollback>
 #include <algorithm>
@@ -44,10 +46,9 @@ QString octantPath(morton::Code code) {
 QString describeNode(const Hierarchy& hierarchy, int level, std::uint32_t index) {
     const OctreeNode& node = hierarchy.node(level, index);
     const CubeTransform& cube = hierarchy.cloud().cube();
-    const morton::Cell cell = morton::decode(node.code);
-    const double size = 1.0 / static_cast<double>(std::uint64_t{1} << level);
-    const glm::dvec3 low = cube.origin + glm::dvec3(cell.x, cell.y, cell.z) * size * cube.edge;
-    const glm::dvec3 high = low + glm::dvec3(size * cube.edge);
+    const CellBox box = cellBox(node.code);
+    const glm::dvec3 low = cube.origin + box.min * cube.edge;
+    const glm::dvec3 high = low + glm::dvec3(box.edge * cube.edge);
     const QLocale locale;
     const auto point = [](const glm::dvec3& p) {
         return QStringLiteral("(%1, %2, %3)")

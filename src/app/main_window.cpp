@@ -177,11 +177,10 @@ void MainWindow::connectActions() {
     connect(m_cutPanel, &CutPanel::nodeSelectionCleared, m_view, &CloudView::clearHighlightedNode);
 
     auto* renderModes = new QActionGroup(this);
-    const std::pair<QAction*, RenderMode> renderModeActions[] = {
-        {m_ui->actionComputePoints, RenderMode::ComputePoints},
-        {m_ui->actionPoints, RenderMode::Points},
-        {m_ui->actionSplats, RenderMode::Splats}};
-    for (const auto& [action, mode] : renderModeActions) {
+    m_renderModeActions = {{m_ui->actionComputePoints, RenderMode::ComputePoints},
+                           {m_ui->actionPoints, RenderMode::Points},
+                           {m_ui->actionSplats, RenderMode::Splats}};
+    for (const auto& [action, mode] : m_renderModeActions) {
         renderModes->addAction(action);
         action->setChecked(mode == ViewParameters{}.renderMode);
         connect(action, &QAction::triggered, this, [this, mode = mode] {
@@ -272,7 +271,7 @@ void MainWindow::connectService() {
                 m_progress = progress;
                 m_cutPanel->setProgress(progress);
                 m_chartsPanel->setProgress(progress);
-                if (progress.phase == BuildPhase::Opening && progress.bytesToScan > 0) {
+                if (progress.scanningBounds()) {
                     m_progressBar->setValue(
                         static_cast<int>(1000.0 * progress.bytesScanned / progress.bytesToScan));
                 } else {
@@ -306,8 +305,7 @@ void MainWindow::connectService() {
             // Cancelled before the new file replaced anything (its bounds pre-pass): the view
             // still shows the previous cloud, so does the title.
             const QString previous = m_title;
-            m_title = kept->path.empty() ? tr("generated scene")
-                                         : QFileInfo(QString::fromStdString(kept->path)).fileName();
+            m_title = m_service->sourceTitle();
             setWindowTitle(tr("%1 — omicron").arg(m_title));
             statusBar()->showMessage(tr("Opening %1 cancelled").arg(previous), 10000);
             return;
@@ -479,7 +477,7 @@ void MainWindow::updateActions() {
 
 void MainWindow::updateStatus() {
     const QLocale locale;
-    m_phaseLabel->setText(m_progress.phase == BuildPhase::Opening && m_progress.bytesToScan > 0
+    m_phaseLabel->setText(m_progress.scanningBounds()
                               ? tr("scanning bounds")
                               : QString::fromLatin1(toString(m_progress.phase)));
     m_pointsLabel->setText(tr("%1 / %2 points")
@@ -494,9 +492,9 @@ void MainWindow::updateStatus() {
 }
 
 void MainWindow::applyViewParameters(const ViewParameters& parameters) {
-    m_ui->actionComputePoints->setChecked(parameters.renderMode == RenderMode::ComputePoints);
-    m_ui->actionPoints->setChecked(parameters.renderMode == RenderMode::Points);
-    m_ui->actionSplats->setChecked(parameters.renderMode == RenderMode::Splats);
+    for (const auto& [action, mode] : m_renderModeActions) {
+        action->setChecked(parameters.renderMode == mode);
+    }
     RenderSettings settings = m_view->renderSettings();
     settings.projectionThresholdPx = parameters.projectionThresholdPx;
     settings.pointBudget = parameters.pointBudget;

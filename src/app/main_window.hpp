@@ -13,6 +13,8 @@
 #include <QStringList>
 #include <QTimer>
 #include <memory>
+#include <utility>
+#include <vector>
 
 class QLabel;
 class QMessageBox;
@@ -80,6 +82,8 @@ private:
     QString askSavePath(const QString& title, const QString& filter, const QString& suffix);
 
     std::unique_ptr<Ui::MainWindow> m_ui;
+    // View > Render Mode: each action and the mode it selects.
+    std::vector<std::pair<QAction*, RenderMode>> m_renderModeActions;
     BuilderService* m_service = nullptr;
     CloudView* m_view = nullptr;
     BuildPanel* m_buildPanel = nullptr;

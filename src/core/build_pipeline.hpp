@@ -69,6 +69,9 @@ struct PipelineProgress {
     // size; both 0 when the source has no pre-pass (LAS, .oms, .omh, the generated scene).
     std::uint64_t bytesScanned = 0;
     std::uint64_t bytesToScan = 0;
+
+    // Opening a file that is being scanned for its bounds: no point is read yet.
+    bool scanningBounds() const { return phase == BuildPhase::Opening && bytesToScan > 0; }
 };
 
 // What the source is, known once it is opened.

@@ -77,8 +77,6 @@ public:
     const std::shared_ptr<const SortedCloud>& sharedCloud() const { return m_cloud; }
     // True when splat normals are estimated (the cloud has no normals of its own).
     bool estimatesNormals() const { return !m_cloud->attributes().has(Attribute::Normal); }
-    // The stored attributes of a loaded hierarchy; nullptr for a build.
-    const StoredSplats* storedSplats() const { return m_storedSplats.get(); }
 
     // ---- Reader side: any thread, no locks. ----
 
@@ -129,7 +127,6 @@ public:
     // Appends a complete node to `level` (Morton order). Not visible before publishNodes().
     std::size_t appendNode(int level, const OctreeNode& node);
     std::size_t builtNodeCount(int level) const { return m_levels[level]->nodes.size(); }
-    std::uint32_t* allocateSamples(std::size_t count) { return m_samples.allocate(count); }
     // Keeps a buffer of samples a worker filled (no copy); returns where its elements now live.
     const std::uint32_t* adoptSamples(std::vector<std::uint32_t>&& samples) {
         return m_samples.adopt(std::move(samples));

@@ -109,19 +109,14 @@ private:
     Bounds boundsPrePass(const OpenOptions& options) {
         Bounds bounds;
         PrePassMonitor monitor(options, m_stream.path(), m_stream.size());
-        if (!monitor.reached(m_header.pointDataOffset)) {
-            monitor.throwCancelled();
-        }
+        monitor.advance(m_header.pointDataOffset);
         forEachBlock([&](const std::uint8_t* records, std::uint64_t count, std::uint64_t first) {
             for (std::uint64_t i = 0; i < count; ++i) {
                 bounds.extend(sourcePosition(records + i * m_header.recordLength));
             }
             return monitor.reached(m_header.recordOffset(first + count));
         });
-        if (monitor.cancelled()) {
-            monitor.throwCancelled();
-        }
-        monitor.finished();
+        monitor.finish();
         return bounds;
     }
 

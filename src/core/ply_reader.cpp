@@ -660,9 +660,7 @@ void PlyReader::runBoundsPrePass(const OpenOptions& options) {
     Bounds bounds;
     std::uint64_t finite = 0;
     PrePassMonitor monitor(options, m_stream.path(), m_stream.size());
-    if (!monitor.reached(m_vertexStart)) {
-        monitor.throwCancelled();
-    }
+    monitor.advance(m_vertexStart);
     if (fastLayout()) {
         // Min/max of the stored floats, offset added once at the end: double(x) + offset is
         // monotonic in x, so this equals the per-point bounds read() checks against.
@@ -694,10 +692,7 @@ void PlyReader::runBoundsPrePass(const OpenOptions& options) {
             return monitor.reached(binary() ? byteOrLine : m_stream.position());
         });
     }
-    if (monitor.cancelled()) {
-        monitor.throwCancelled();
-    }
-    monitor.finished();
+    monitor.finish();
     if (finite == 0) {
         throwNoFinitePoints();
     }

@@ -14,6 +14,11 @@
 
 namespace omicron {
 
+OpenCancelled::OpenCancelled(const std::string& path, std::uint64_t bytesScanned)
+    : std::runtime_error(path + ": opening cancelled during the bounds pre-pass (after " +
+                         std::to_string(bytesScanned) + " bytes)"),
+      m_path(path), m_bytesScanned(bytesScanned) {}
+
 const char* toString(CloudFormat format) {
     switch (format) {
     case CloudFormat::PlyAscii:

@@ -2,11 +2,6 @@
 
 namespace omicron {
 
-OpenCancelled::OpenCancelled(const std::string& path, std::uint64_t bytesScanned)
-    : std::runtime_error(path + ": opening cancelled during the bounds pre-pass (after " +
-                         std::to_string(bytesScanned) + " bytes)"),
-      m_path(path), m_bytesScanned(bytesScanned) {}
-
 bool PrePassMonitor::report(std::uint64_t offset) {
     m_nextReport = offset + kReportBytes;
     if (m_options.onPrePassProgress) {

@@ -20,16 +20,27 @@ public:
         : m_options(options), m_path(std::move(path)), m_fileBytes(fileBytes) {}
 
     // The scan has read the file up to byte `offset`. Cheap between reports (one compare),
-    // so text scans call it per line. False once cancelled: the scan stops and calls
-    // throwCancelled().
+    // so text scans call it per line. False once cancelled: a block visitor returns it to stop
+    // the scan, which then ends with finish().
     bool reached(std::uint64_t offset) { return offset < m_nextReport || report(offset); }
-    // The scan read the whole file: a last report at its size.
-    void finished() { report(m_fileBytes); }
-    bool cancelled() const { return m_cancelled; }
-    [[noreturn]] void throwCancelled() const;
+    // The same, for a scan that can stop where it stands: throws OpenCancelled when cancelled.
+    void advance(std::uint64_t offset) {
+        if (!reached(offset)) {
+            throwCancelled();
+        }
+    }
+    // The scan is over: throws OpenCancelled when it was stopped, else a last report at the
+    // file's size.
+    void finish() {
+        if (m_cancelled) {
+            throwCancelled();
+        }
+        report(m_fileBytes);
+    }
 
 private:
     bool report(std::uint64_t offset);
+    [[noreturn]] void throwCancelled() const;
 
     const OpenOptions& m_options;
     std::string m_path;

@@ -1,9 +1,11 @@
 #include "splat_estimator.hpp"
 
+#include "parent_sampler.hpp"
 #include "splat_encoding.hpp"
 #include "unit_cell_box.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 #include <glm/geometric.hpp>
@@ -145,16 +147,17 @@ void sumCells(const SortedCloud& cloud, std::uint32_t count, int fineLevel,
     scratch.cellFirst.push_back(count);
 }
 
-// Moments of at most kRegionSamples evenly spaced points of the region.
+// Moments of at most kRegionSamples evenly spaced points of the region (the parents'
+// stratified picks).
 SplatScratch::Moments regionMoments(const SortedCloud& cloud, const SparseSplatRegion& region,
                                     const glm::dvec3& origin) {
     const glm::vec3* positions = cloud.positions().data();
-    const std::uint32_t samples = std::min(region.count, kRegionSamples);
+    std::array<std::uint32_t, kRegionSamples> picks;
+    const std::span<std::uint32_t> samples(picks.data(), std::min(region.count, kRegionSamples));
+    sampleRange(region.begin, region.count, samples);
     SplatScratch::Moments moments;
-    for (std::uint32_t j = 0; j < samples; ++j) {
-        const std::uint64_t offset =
-            (2 * std::uint64_t{j} + 1) * region.count / (2 * std::uint64_t{samples});
-        const glm::vec3& p = positions[region.begin + offset];
+    for (const std::uint32_t point : samples) {
+        const glm::vec3& p = positions[point];
         moments.add(p.x - origin.x, p.y - origin.y, p.z - origin.z);
     }
     return moments;

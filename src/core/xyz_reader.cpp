@@ -391,9 +391,7 @@ XyzScan scanFile(FileStream& stream, PrePassMonitor& monitor) {
     Row row;
     stream.seek(0);
     LineReader lines(stream);
-    if (!monitor.reached(0)) {
-        monitor.throwCancelled();
-    }
+    monitor.advance(0);
     findFirstDataLine(lines, row, scan, path);
     // The 6-column layout is not decided yet; neither candidate has a colour check here.
     const ColumnLayout layout = layoutFor(scan.columns, false);
@@ -401,14 +399,12 @@ XyzScan scanFile(FileStream& stream, PrePassMonitor& monitor) {
     scanRow(row, layout.intensity, colorColumn, scan, path, scan.dataLine);
     std::string_view line;
     while (nextContentLine(lines, line)) {
-        if (!monitor.reached(lines.lineOffset())) {
-            monitor.throwCancelled();
-        }
+        monitor.advance(lines.lineOffset());
         row.parse(line);
         checkRow(row, scan.columns, scan.dataLine, path, lines.lineNumber());
         scanRow(row, layout.intensity, colorColumn, scan, path, lines.lineNumber());
     }
-    monitor.finished();
+    monitor.finish();
     return scan;
 }
 

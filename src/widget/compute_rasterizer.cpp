@@ -42,15 +42,8 @@ void bindBufferTexture(QOpenGLExtraFunctions& gl, GLenum unit, unsigned texture,
 } // namespace
 
 void ComputeRasterizer::initializeGL(QOpenGLContext& context) {
-    m_depthProgram.reset();
-    m_colorProgram.reset();
-    m_resolveProgram.reset();
     // A new context: the old one's objects went with it.
-    m_depthImage = m_colorImage = m_clearFramebuffer = 0;
-    m_drawNodeBuffer = m_chunkBuffer = 0;
-    m_pageTexture = m_drawNodeTexture = m_chunkTexture = 0;
-    m_widthPx = m_heightPx = 0;
-    m_targetsComplete = false;
+    forgetObjects();
     m_maxPageBytes = 0;
     if (disabledByEnvironment()) {
         qInfo("omicron::CloudView: %s is set: compute points are drawn as GL points",
@@ -88,15 +81,28 @@ void ComputeRasterizer::initializeGL(QOpenGLContext& context) {
     gl.glGenTextures(1, &m_chunkTexture);
 }
 
+void ComputeRasterizer::forgetTargets() {
+    m_depthImage = m_colorImage = m_clearFramebuffer = 0;
+    m_widthPx = m_heightPx = 0;
+    m_targetsComplete = false;
+}
+
+void ComputeRasterizer::forgetObjects() {
+    forgetTargets();
+    m_drawNodeBuffer = m_chunkBuffer = 0;
+    m_pageTexture = m_drawNodeTexture = m_chunkTexture = 0;
+    m_depthProgram.reset();
+    m_colorProgram.reset();
+    m_resolveProgram.reset();
+}
+
 void ComputeRasterizer::releaseTargets(QOpenGLExtraFunctions& gl) {
     if (m_depthImage != 0) {
         gl.glDeleteFramebuffers(1, &m_clearFramebuffer);
         gl.glDeleteTextures(1, &m_depthImage);
         gl.glDeleteTextures(1, &m_colorImage);
     }
-    m_depthImage = m_colorImage = m_clearFramebuffer = 0;
-    m_widthPx = m_heightPx = 0;
-    m_targetsComplete = false;
+    forgetTargets();
 }
 
 void ComputeRasterizer::release(QOpenGLExtraFunctions& gl) {
@@ -108,11 +114,7 @@ void ComputeRasterizer::release(QOpenGLExtraFunctions& gl) {
         gl.glDeleteTextures(1, &m_drawNodeTexture);
         gl.glDeleteTextures(1, &m_chunkTexture);
     }
-    m_drawNodeBuffer = m_chunkBuffer = 0;
-    m_pageTexture = m_drawNodeTexture = m_chunkTexture = 0;
-    m_depthProgram.reset();
-    m_colorProgram.reset();
-    m_resolveProgram.reset();
+    forgetObjects();
 }
 
 bool ComputeRasterizer::ensureSize(QOpenGLExtraFunctions& gl, int widthPx, int heightPx) {

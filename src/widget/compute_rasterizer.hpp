@@ -91,6 +91,9 @@ private:
     void uploadTables(QOpenGLExtraFunctions& gl);
     void dispatchPass(QOpenGLExtraFunctions& gl, QOpenGLShaderProgram& program);
     void releaseTargets(QOpenGLExtraFunctions& gl);
+    // Zero the handles (after deleting them, or when their context is gone).
+    void forgetTargets();
+    void forgetObjects();
 
     std::unique_ptr<QOpenGLShaderProgram> m_depthProgram;
     std::unique_ptr<QOpenGLShaderProgram> m_colorProgram;

@@ -60,9 +60,7 @@ public:
         if (corrupt) {
             corrupt(parent, samples);
         }
-        std::uint32_t* stored = m_hierarchy.allocateSamples(samples.size());
-        std::copy(samples.begin(), samples.end(), stored);
-        parent.sampleIndices = stored;
+        parent.sampleIndices = m_hierarchy.adoptSamples(std::move(samples));
         const std::size_t index = m_hierarchy.appendNode(parentLevel, parent);
         m_hierarchy.publishNodes(parentLevel);
         return {parent.code, static_cast<std::uint32_t>(index), false};

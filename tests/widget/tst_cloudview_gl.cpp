@@ -181,9 +181,6 @@ private slots:
         QVERIFY(!view.highlightedNode().has_value());
     }
 
-    // The front insertion delay (leaf published -> first drawn) through a real build: every
-    // leaf the builder logs after the view attached is counted exactly once over the frames,
-    // each frame with its median below its maximum.
     // Frames are drawn on demand: the rate is measured over frames drawn back to back, and a
     // frame after a pause starts a new window instead of reporting the pause as a low rate.
     void framesPerSecondIgnoreIdlePauses() {
@@ -209,6 +206,9 @@ private slots:
         QVERIFY(view.lastFrameStats().fps > 2.0);
     }
 
+    // The front insertion delay (leaf published -> first drawn) through a real build: every
+    // leaf the builder logs after the view attached is counted exactly once over the frames,
+    // each frame with its median below its maximum.
     void leafDrawDelayIsMeasuredWhileABuildRuns() {
         const test::SortedScene scene = test::sortGeneratedScene(150'000, 4);
         const auto& ranges = scene.ranges;
