@@ -141,7 +141,21 @@ int main(int argc, char** argv) {
             std::fflush(stdout);
         }
 
-        // (c) leaf collapse x ratio.
+        // (c) leaf collapse x ratio, for either point store (the packed cloud sorted from the
+        // same file: same order, same leaves, positions on the level-21 grid).
+        std::shared_ptr<const omicron::SortedCloud> packed;
+        {
+            auto reader = omicron::openPointCloud(path);
+            omicron::SortOptions sortOptions;
+            sortOptions.storage = omicron::PointStorage::Packed;
+            omicron::sortPointCloud(
+                *reader, sortOptions,
+                [](const omicron::SortedCloud&, std::size_t, std::size_t) {},
+                [&](const omicron::IncrementalMortonSorter& sorter) { packed = sorter.cloud(); });
+        }
+        for (const auto& [storeCloud, store] :
+             {std::pair{cloud, omicron::PointStorage::Exact},
+              std::pair{packed, omicron::PointStorage::Packed}})
         for (omicron::LeafCollapse collapse :
              {omicron::LeafCollapse::Off, omicron::LeafCollapse::Lossless,
               omicron::LeafCollapse::Paper}) {
@@ -149,14 +163,16 @@ int main(int argc, char** argv) {
                 omicron::BuildOptions options = base;
                 options.collapse = collapse;
                 options.ratio = ratio;
-                const BuildResult r = buildBest(cloud, options);
-                std::printf("bench=build_collapse collapse=%s ratio=%.2f creation_ms=%.1f "
-                            "bytes_resident=%zu bytes_per_point=%.1f vs_file_size=%.2f "
-                            "hierarchy_bytes=%zu dropped_points=%llu\n",
-                            omicron::toString(collapse), ratio, r.seconds * 1e3,
+                const BuildResult r = buildBest(storeCloud, options);
+                std::printf("bench=build_collapse store=%s collapse=%s ratio=%.2f "
+                            "creation_ms=%.1f bytes_resident=%zu bytes_per_point=%.1f "
+                            "vs_file_size=%.2f cloud_bytes=%zu hierarchy_bytes=%zu "
+                            "dropped_points=%llu\n",
+                            omicron::toString(store), omicron::toString(collapse), ratio,
+                            r.seconds * 1e3,
                             r.stats.bytesResident(),
                             double(r.stats.bytesResident()) / double(points),
-                            double(r.stats.bytesResident()) / fileBytes,
+                            double(r.stats.bytesResident()) / fileBytes, r.stats.cloudBytes,
                             r.stats.bytesResident() - r.stats.cloudBytes,
                             static_cast<unsigned long long>(r.stats.droppedPoints));
                 std::fflush(stdout);

@@ -56,6 +56,7 @@ PipelineOptions BuildPanel::pipelineOptions() const {
     options.build.worklistSize = static_cast<std::size_t>(m_ui->worklistSpin->value());
     options.build.threads = m_ui->threadsSpin->value();
     options.sortChunks = m_ui->chunksSpin->value();
+    options.storage = static_cast<PointStorage>(m_ui->storeCombo->currentIndex());
     return options;
 }
 
@@ -66,6 +67,7 @@ void BuildPanel::setPipelineOptions(const PipelineOptions& options) {
     m_ui->worklistSpin->setValue(static_cast<int>(options.build.worklistSize));
     m_ui->threadsSpin->setValue(options.build.threads);
     m_ui->chunksSpin->setValue(options.sortChunks);
+    m_ui->storeCombo->setCurrentIndex(static_cast<int>(options.storage));
 }
 
 ViewParameters BuildPanel::viewParameters() const {
@@ -96,6 +98,7 @@ void BuildPanel::loadSettings(const QSettings& settings) {
         settings.value("build/worklist", qulonglong(defaults.build.worklistSize)).toULongLong();
     options.build.threads = settings.value("build/threads", 0).toInt();
     options.sortChunks = settings.value("build/sortChunks", defaults.sortChunks).toInt();
+    parsePointStorage(settings.value("build/pointStore").toString().toStdString(), options.storage);
     setPipelineOptions(options);
     const ViewParameters viewDefaults;
     ViewParameters view;
@@ -122,6 +125,7 @@ void BuildPanel::saveSettings(QSettings& settings) const {
     settings.setValue("build/worklist", qulonglong(options.build.worklistSize));
     settings.setValue("build/threads", options.build.threads);
     settings.setValue("build/sortChunks", options.sortChunks);
+    settings.setValue("build/pointStore", QLatin1String(toString(options.storage)));
     const ViewParameters view = viewParameters();
     settings.setValue("view/projectionThresholdPx", view.projectionThresholdPx);
     settings.setValue("view/pointBudget", qulonglong(view.pointBudget));

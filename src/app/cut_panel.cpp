@@ -203,14 +203,15 @@ void CutPanel::setStatistics(const BuildStatistics& statistics) {
     const QLocale locale;
     m_ui->summaryLabel->setText(
         tr("%1 nodes · %2 fix passes (%3 restarted) · %4 duplicate parents merged · "
-           "%5 placeholders (%6 substituted) · %7 MiB")
+           "%5 placeholders (%6 substituted) · %7 MiB (%8 points)")
             .arg(locale.toString(quint64(statistics.totalNodes())))
             .arg(statistics.fixPasses)
             .arg(statistics.passesRestarted)
             .arg(statistics.duplicateParentsMerged)
             .arg(statistics.placeholdersCreated)
             .arg(statistics.placeholdersSubstituted)
-            .arg(statistics.bytesResident() / 1048576.0, 0, 'f', 1));
+            .arg(statistics.bytesResident() / 1048576.0, 0, 'f', 1)
+            .arg(QLatin1String(toString(statistics.pointStorage))));
 }
 
 void CutPanel::clear() {

@@ -84,6 +84,10 @@ void printJson(const PipelineResult& run, const BuildOptions& options, const Sav
     json.key("read_s").value(run.readSeconds);
     json.key("sort_s").value(run.sortSeconds);
     json.key("bytes_resident").value(static_cast<std::uint64_t>(s.bytesResident()));
+    json.key("point_storage").value(toString(s.pointStorage));
+    json.key("cloud_bytes").value(static_cast<std::uint64_t>(s.cloudBytes));
+    json.key("hierarchy_bytes")
+        .value(static_cast<std::uint64_t>(s.nodeBytes + s.sampleBytes + s.splatBytes));
     json.key("milestones_s").beginArray();
     for (double seconds : s.milestonesSeconds) {
         json.value(seconds);
@@ -118,9 +122,10 @@ void printText(const PipelineResult& run, const BuildOptions& options, const Sav
     }
     std::printf("time:        read %.3f s, sort %.3f s, hierarchy complete %.3f s after start\n",
                 run.readSeconds, run.sortSeconds, s.creationSeconds);
-    std::printf("memory:      %.1f MiB resident (%.1f bytes per input point)\n",
+    std::printf("memory:      %.1f MiB resident (%.1f bytes per input point), %s point store\n",
                 s.bytesResident() / 1048576.0,
-                s.inputPoints ? double(s.bytesResident()) / double(s.inputPoints) : 0.0);
+                s.inputPoints ? double(s.bytesResident()) / double(s.inputPoints) : 0.0,
+                toString(s.pointStorage));
     if (!saved.path.empty()) {
         std::printf("saved:       %s (%llu bytes)\n", saved.path.c_str(),
                     static_cast<unsigned long long>(saved.bytes));
@@ -134,6 +139,7 @@ int runBuild(const std::vector<std::string>& args) {
                                                {"collapse", true},
                                                {"threads", true},
                                                {"chunks", true},
+                                               {"store", true},
                                                {"json", false},
                                                {"save", true}});
     if (parsed.help) {
@@ -163,9 +169,14 @@ int runBuild(const std::vector<std::string>& args) {
     tbb::global_control threadLimit(tbb::global_control::max_allowed_parallelism,
                                     static_cast<std::size_t>(threads));
 
+    PointStorage storage = PointStorage::Exact;
+    if (const auto store = parsed.value("store"); store && !parsePointStorage(*store, storage)) {
+        throw UsageError("--store takes exact or packed, found '" + *store + "'");
+    }
+
     const std::string& path = parsed.positionals[0];
     BuildPipeline pipeline;
-    const PipelineResult run = pipeline.run(path, {options, chunks});
+    const PipelineResult run = pipeline.run(path, {options, chunks, storage});
     SavedFile saved;
     if (const auto savePath = parsed.value("save")) { // the finished hierarchy, pipeline 3's input
         writeOmh(*savePath, *pipeline.hierarchy(), omhBuildInfo(options, run.stats), saveOptions());
@@ -185,7 +196,8 @@ const Command& buildCommand() {
     static const Command command{
         "build", "build the OMiCroN hierarchy of a cloud and print its statistics",
         "build IN [--depth 7] [--ratio 0.2] [--worklist N] [--collapse off|lossless|paper]\n"
-        "                   [--threads T] [--chunks K] [--save OUT.omh] [--json]",
+        "                   [--threads T] [--chunks K] [--store exact|packed] [--save OUT.omh]\n"
+        "                   [--json]",
         "Builds the octree bottom-up with oblique hierarchy cuts while the input streams in:\n"
         "an unsorted cloud (PLY, LAS, XYZ) goes through the incremental Morton sorter first\n"
         "(pipeline 1), a sorted stream (.oms) feeds the builder directly (pipeline 2).\n"
@@ -198,11 +210,16 @@ const Command& buildCommand() {
         "                     points are counted)\n"
         "  --threads T        worker threads (default: all cores)\n"
         "  --chunks K         sort chunks for unsorted input, 1..256 (default 32)\n"
+        "  --store MODE       exact (default: positions and colours as read) or packed\n"
+        "                     (positions quantised to the level-21 grid, at most half a\n"
+        "                     cell = 2^-22 of the cube's edge off, and colours, bit-packed\n"
+        "                     per 64 points: about half the memory)\n"
         "  --save OUT.omh     save the finished hierarchy as a .omh file (written to a\n"
         "                     temporary file and renamed: an interrupted save leaves OUT as\n"
         "                     it was); 'info OUT.omh' prints the same per-level counts\n"
         "  --json             one JSON object: points_in, levels [{level, nodes, leaves,\n"
-        "                     points}], creation_s, read_s, sort_s, bytes_resident,\n"
+        "                     points}], creation_s, read_s, sort_s, bytes_resident\n"
+        "                     (cloud_bytes + hierarchy_bytes), point_storage,\n"
         "                     milestones_s (time at 10 %, 20 %, ... of the points inserted),\n"
         "                     saved and saved_bytes with --save\n"
         "\n"

@@ -142,7 +142,7 @@ InfoReport readSortedStream(const std::string& path) {
     Bounds bounds;
     report.summary = reader.read([&](const SortedCloud& cloud, std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
-            bounds.extend(cloud.cube().toSource(cloud.positions()[i]));
+            bounds.extend(cloud.cube().toSource(cloud.position(i)));
         }
     });
     report.info.sourceBounds = bounds;

@@ -239,6 +239,7 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
     SortOptions sortOptions;
     sortOptions.chunks = options.sortChunks;
     sortOptions.cancel = &m_cancel;
+    sortOptions.storage = options.storage;
     auto sorter = std::make_shared<IncrementalMortonSorter>(info, sortOptions);
     PipelineResult result;
     result.pipeline = toString(PipelineKind::UnsortedCloud);
@@ -287,7 +288,7 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
 PipelineResult BuildPipeline::runSortedStream(const std::string& path,
                                               const PipelineOptions& options) {
     beginRun(BuildPhase::Opening);
-    OmsReader reader(path);
+    OmsReader reader(path, options.storage);
     const OmsInfo& info = reader.info();
     PipelineResult result;
     result.pipeline = toString(PipelineKind::SortedStream);
@@ -340,6 +341,7 @@ PipelineResult BuildPipeline::runGeneratedScene(std::uint64_t points, std::uint6
     SortOptions sortOptions;
     sortOptions.chunks = options.sortChunks;
     sortOptions.cancel = &m_cancel;
+    sortOptions.storage = options.storage;
     auto sorter = std::make_shared<IncrementalMortonSorter>(info, sortOptions);
     PipelineResult result;
     result.pipeline = toString(PipelineKind::GeneratedScene);

@@ -99,6 +99,9 @@ struct PipelineResult {
 struct PipelineOptions {
     BuildOptions build;
     int sortChunks = kDefaultSortChunks; // 1..kMaxSortChunks, pipeline 1 only
+    // How the sorted cloud keeps positions and colours (pipelines 1 and 2; a rebuild keeps the
+    // cloud it has).
+    PointStorage storage = PointStorage::Exact;
 };
 
 // Points and seed of the built-in default scene when a front end shows it at start-up.

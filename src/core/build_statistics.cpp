@@ -11,8 +11,7 @@ std::uint64_t BuildStatistics::totalNodes() const {
 }
 
 std::size_t sortedCloudBytes(const SortedCloud& cloud) {
-    return cloud.positions().size_bytes() + cloud.normals().size_bytes() +
-           cloud.colors().size_bytes() + cloud.intensities().size_bytes();
+    return cloud.bytesResident();
 }
 
 void recordMilestones(std::array<double, 10>& milestones, std::uint64_t inserted,

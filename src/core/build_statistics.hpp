@@ -42,7 +42,8 @@ struct BuildStatistics {
     std::uint64_t worklists = 0;              // parallel work items run (leaves and fix)
     std::uint64_t duplicateParentsMerged = 0; // sibling groups split by a worklist boundary
 
-    std::size_t cloudBytes = 0; // the SortedCloud the nodes index (codes, positions, ...)
+    PointStorage pointStorage = PointStorage::Exact; // how the cloud keeps its points
+    std::size_t cloudBytes = 0; // the SortedCloud the nodes index (positions, colours, ...)
     std::size_t nodeBytes = 0;
     std::size_t sampleBytes = 0; // parents' sample index lists
     std::size_t splatBytes = 0;  // per-point radius (and estimated normal)

@@ -70,13 +70,14 @@ SparseSplatRegion Hierarchy::sparseSplatRegion(const OctreeNode& node) const {
     if (node.level() != m_maxLevel || m_maxLevel == 0 || node.pointCount == 0) {
         return {node.coveredBegin, node.coveredCount, node.coveredCount};
     }
-    const std::span<const glm::vec3> positions = m_cloud->positions();
     const int groupLevel = m_maxLevel - 1;
-    const std::size_t begin = startOfRun(positions, node.coveredBegin, groupLevel);
-    const std::size_t end =
-        endOfRun(positions, node.coveredBegin, m_cloud->sortedEnd(), groupLevel);
-    const auto count = static_cast<std::uint32_t>(end - begin);
-    return {static_cast<std::uint32_t>(begin), count, count};
+    return m_cloud->visitPositions([&](const auto& positions) -> SparseSplatRegion {
+        const std::size_t begin = startOfRun(positions, node.coveredBegin, groupLevel);
+        const std::size_t end =
+            endOfRun(positions, node.coveredBegin, m_cloud->sortedEnd(), groupLevel);
+        const auto count = static_cast<std::uint32_t>(end - begin);
+        return {static_cast<std::uint32_t>(begin), count, count};
+    });
 }
 
 PublishedCut Hierarchy::publishedCut() const {

@@ -135,6 +135,7 @@ HierarchyBuilder::HierarchyBuilder(std::shared_ptr<const SortedCloud> cloud,
       m_start(std::chrono::steady_clock::now()) {
     m_stats.levels.resize(static_cast<std::size_t>(options.maxLevel) + 1);
     m_stats.cloudBytes = sortedCloudBytes(*m_cloud);
+    m_stats.pointStorage = m_cloud->storage();
     m_publishedStats = m_stats;
     m_thread = std::thread([this] { run(); });
 }
@@ -270,19 +271,21 @@ void HierarchyBuilder::insertInput(std::size_t available, bool inputEnded) {
     // Whole sibling groups only: leaf collapse must see a leaf's siblings, and a sparse leaf's
     // splat estimate borrows its siblings' points (Hierarchy::sparseSplatRegion).
     const int groupLevel = maxLevel - 1;
-    const std::span<const glm::vec3> positions = m_cloud->positions();
-    const std::size_t end = insertableEnd(positions, m_insertedEnd, available, inputEnded,
-                                          groupLevel, kMaxInsertPoints);
-    m_inputBacklog =
-        insertableEnd(positions, end, available, inputEnded, groupLevel, kMaxInsertPoints) > end;
+    Worker& worker = *m_worker;
+    std::vector<LeafRun>& runs = worker.runs;
+    runs.clear();
+    const std::size_t end = m_cloud->visitPositions([&](const auto& positions) {
+        const std::size_t cut = insertableEnd(positions, m_insertedEnd, available, inputEnded,
+                                              groupLevel, kMaxInsertPoints);
+        m_inputBacklog = insertableEnd(positions, cut, available, inputEnded, groupLevel,
+                                       kMaxInsertPoints) > cut;
+        findLeafRuns(positions, m_insertedEnd, cut, maxLevel, runs);
+        return cut;
+    });
     if (end == m_insertedEnd) {
         return;
     }
 
-    Worker& worker = *m_worker;
-    std::vector<LeafRun>& runs = worker.runs;
-    runs.clear();
-    findLeafRuns(positions, m_insertedEnd, end, maxLevel, runs);
     // Sibling groups: runs [groupFirst[g], groupFirst[g + 1]).
     std::vector<std::uint32_t>& groupOf = worker.groupOf;
     std::vector<std::size_t>& groupFirst = worker.groupFirst;
@@ -502,6 +505,7 @@ void HierarchyBuilder::publishStatistics() {
         levelStats.placeholdersPending = static_cast<std::uint64_t>(std::count_if(
             roots.begin(), roots.end(), [](const CutRoot& r) { return r.placeholder; }));
     }
+    m_stats.cloudBytes = sortedCloudBytes(*m_cloud); // a packed store grows with the input
     m_stats.nodeBytes = m_hierarchy->nodeBytes();
     m_stats.sampleBytes = m_hierarchy->sampleBytes();
     m_stats.splatBytes = m_hierarchy->splatBytes();

@@ -4,10 +4,12 @@
 // makes every such run contiguous. A range handed over by the sorter can end in the middle of
 // a run (or, for leaf collapse, of a sibling group), so the tail of the input is held back
 // until the next range or the end of input says where it stops. Everything works on the
-// points' unit-cube positions (their codes are morton::encodeUnit of them).
+// points' unit-cube positions (their codes are morton::encodeUnit of them), read through a
+// PositionView (either point store); the span overloads read a plain array.
 #pragma once
 
 #include "morton.hpp"
+#include "position_views.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -25,23 +27,55 @@ struct LeafRun {
 
 // The end of the index range [begin, end) of points that share the cell of positions[begin] at
 // `level` (exponential then binary search: O(log run length)).
-std::size_t endOfRun(std::span<const glm::vec3> positions, std::size_t begin, std::size_t end,
-                     int level);
+template <PositionView Positions>
+std::size_t endOfRun(const Positions& positions, std::size_t begin, std::size_t end, int level);
 
 // The start of the run of points sharing the cell of positions[last] at `level` that ends at
 // `last` (inclusive): the mirror of endOfRun, searching towards the front.
-std::size_t startOfRun(std::span<const glm::vec3> positions, std::size_t last, int level);
+template <PositionView Positions>
+std::size_t startOfRun(const Positions& positions, std::size_t last, int level);
 
 // Appends to `runs` the leaves at maxLevel of positions[begin, end) (in parallel blocks).
-void findLeafRuns(std::span<const glm::vec3> positions, std::size_t begin, std::size_t end,
-                  int maxLevel, std::vector<LeafRun>& runs);
+template <PositionView Positions>
+void findLeafRuns(const Positions& positions, std::size_t begin, std::size_t end, int maxLevel,
+                  std::vector<LeafRun>& runs);
 
 // How far [begin, available) may be cut into leaves now, taking at most about `limit` points:
 // the returned end never splits a group of points sharing their cell at `groupLevel` (a leaf,
 // or a sibling group when leaf collapse must see a leaf's siblings), unless `inputEnded`.
 // Returns `begin` when the only group in reach may still grow with later input.
-std::size_t insertableEnd(std::span<const glm::vec3> positions, std::size_t begin,
-                          std::size_t available, bool inputEnded, int groupLevel,
-                          std::size_t limit);
+template <PositionView Positions>
+std::size_t insertableEnd(const Positions& positions, std::size_t begin, std::size_t available,
+                          bool inputEnded, int groupLevel, std::size_t limit);
+
+#define OMICRON_LEAF_RUNS_EXTERN(Positions)                                                      \
+    extern template std::size_t endOfRun(const Positions&, std::size_t, std::size_t, int);      \
+    extern template std::size_t startOfRun(const Positions&, std::size_t, int);                 \
+    extern template void findLeafRuns(const Positions&, std::size_t, std::size_t, int,          \
+                                      std::vector<LeafRun>&);                                   \
+    extern template std::size_t insertableEnd(const Positions&, std::size_t, std::size_t, bool, \
+                                              int, std::size_t);
+OMICRON_LEAF_RUNS_EXTERN(ExactPositions)
+OMICRON_LEAF_RUNS_EXTERN(PackedPositions)
+#undef OMICRON_LEAF_RUNS_EXTERN
+
+// The same over a plain array of positions.
+inline std::size_t endOfRun(std::span<const glm::vec3> positions, std::size_t begin,
+                            std::size_t end, int level) {
+    return endOfRun(ExactPositions{positions.data()}, begin, end, level);
+}
+inline std::size_t startOfRun(std::span<const glm::vec3> positions, std::size_t last, int level) {
+    return startOfRun(ExactPositions{positions.data()}, last, level);
+}
+inline void findLeafRuns(std::span<const glm::vec3> positions, std::size_t begin,
+                         std::size_t end, int maxLevel, std::vector<LeafRun>& runs) {
+    findLeafRuns(ExactPositions{positions.data()}, begin, end, maxLevel, runs);
+}
+inline std::size_t insertableEnd(std::span<const glm::vec3> positions, std::size_t begin,
+                                 std::size_t available, bool inputEnded, int groupLevel,
+                                 std::size_t limit) {
+    return insertableEnd(ExactPositions{positions.data()}, begin, available, inputEnded,
+                         groupLevel, limit);
+}
 
 } // namespace omicron

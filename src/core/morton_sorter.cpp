@@ -39,7 +39,8 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
     m_options.batchPoints = std::max<std::size_t>(m_options.batchPoints, 1);
     const auto capacity = static_cast<std::size_t>(info.pointCount);
     m_cloud =
-        std::make_shared<SortedCloud>(info.cube, info.sourceOffset, info.attributes, capacity);
+        std::make_shared<SortedCloud>(info.cube, info.sourceOffset, info.attributes, capacity,
+                                      CloudOrder::Morton, m_options.storage);
     m_input.attributes = info.attributes;
     m_input.reserve(capacity);
     const std::size_t perBin = capacity / kBins + 16;
@@ -191,21 +192,21 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                                       std::span(indexScratch.data() + at, n));
                    });
                    // Gather every attribute into its sorted place.
-                   const std::size_t base = chunkBegin[c];
+                   const SortedCloud::StagedRange out = cloud.stage(chunkBegin[c + 1]);
                    tbb::parallel_for(
                        tbb::blocked_range<std::size_t>(0, size, 8192),
                        [&](const tbb::blocked_range<std::size_t>& range) {
                            for (std::size_t i = range.begin(); i < range.end(); ++i) {
                                const std::uint32_t from = indices[i];
-                               cloud.mutablePositions()[base + i] = m_input.positions[from];
+                               out.positions[i] = m_input.positions[from];
                                if (!m_input.normals.empty()) {
-                                   cloud.mutableNormals()[base + i] = m_input.normals[from];
+                                   out.normals[i] = m_input.normals[from];
                                }
                                if (!m_input.colors.empty()) {
-                                   cloud.mutableColors()[base + i] = m_input.colors[from];
+                                   out.colors[i] = m_input.colors[from];
                                }
                                if (!m_input.intensities.empty()) {
-                                   cloud.mutableIntensities()[base + i] = m_input.intensities[from];
+                                   out.intensities[i] = m_input.intensities[from];
                                }
                            }
                        });

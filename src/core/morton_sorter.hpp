@@ -35,6 +35,7 @@ struct SortOptions {
     std::size_t previewPoints = std::size_t{1} << 16; // size of the random preview sample
     std::uint64_t previewSeed = 0x9e3779b97f4a7c15ull;
     const std::atomic<bool>* cancel = nullptr;        // checked between chunks and batches
+    PointStorage storage = PointStorage::Exact;       // how the sorted cloud keeps its points
 };
 
 // A uniform random subsample of the points added so far (positions in the unit cube).

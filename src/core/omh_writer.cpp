@@ -43,12 +43,12 @@ public:
         }
         std::uint8_t* record = m_block.data() + m_used;
         const AttributeSet attributes = m_cloud.attributes();
-        store(record, m_cloud.positions()[index]);
+        store(record, m_cloud.position(index));
         if (attributes.has(Attribute::Normal)) {
             store(record + m_layout.point.normalOffset, m_cloud.normals()[index]);
         }
         if (attributes.has(Attribute::Color)) {
-            store(record + m_layout.point.colorOffset, m_cloud.colors()[index]);
+            store(record + m_layout.point.colorOffset, m_cloud.color(index));
         }
         if (attributes.has(Attribute::Intensity)) {
             store(record + m_layout.point.intensityOffset, m_cloud.intensities()[index]);

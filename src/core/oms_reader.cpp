@@ -80,7 +80,7 @@ bool isOmsFile(const std::string& path) {
     }
 }
 
-OmsReader::OmsReader(const std::string& path) : m_stream(path) {
+OmsReader::OmsReader(const std::string& path, PointStorage storage) : m_stream(path) {
     namespace h = oms::header;
     const auto error = [&](InputErrorKind kind, std::uint64_t byte, const std::string& detail) {
         return InputError(kind, path, InputLocation::byte(byte), detail);
@@ -260,7 +260,8 @@ OmsReader::OmsReader(const std::string& path) : m_stream(path) {
     m_info.cube = CubeTransform{origin, edge};
     m_info.sourceOffset = sourceOffset;
     m_cloud = std::make_shared<SortedCloud>(m_info.cube, sourceOffset, attributes,
-                                            static_cast<std::size_t>(pointCount));
+                                            static_cast<std::size_t>(pointCount),
+                                            CloudOrder::Morton, storage);
 }
 
 ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptions& options) {
@@ -275,10 +276,6 @@ ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptio
     const std::size_t rangePoints =
         std::max<std::size_t>(1, std::min(options.batchPoints, kBlockBytes / recordBytes));
     const AttributeSet attributes = m_info.attributes;
-    const auto positions = cloud.mutablePositions();
-    const auto normals = cloud.mutableNormals();
-    const auto colors = cloud.mutableColors();
-    const auto intensities = cloud.mutableIntensities();
     oms::PayloadChecksum checksum;
     morton::Code previousCode = 0;
 
@@ -295,6 +292,7 @@ ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptio
                            "records " + std::to_string(begin) + " to " + std::to_string(end - 1));
         checksum.update(m_block.data(), m_block.size());
         const std::uint8_t* record = m_block.data();
+        const SortedCloud::StagedRange out = cloud.stage(end);
         for (std::size_t i = begin; i < end; ++i, record += recordBytes) {
             const auto p = load<glm::vec3>(record);
             if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
@@ -314,15 +312,16 @@ ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptio
                         hex(code) + " is below the previous record's " + hex(previousCode) + ")");
             }
             previousCode = code;
-            positions[i] = p;
+            const std::size_t at = i - begin;
+            out.positions[at] = p;
             if (attributes.has(Attribute::Normal)) {
-                normals[i] = load<glm::vec3>(record + m_layout.normalOffset);
+                out.normals[at] = load<glm::vec3>(record + m_layout.normalOffset);
             }
             if (attributes.has(Attribute::Color)) {
-                colors[i] = load<glm::u8vec3>(record + m_layout.colorOffset);
+                out.colors[at] = load<glm::u8vec3>(record + m_layout.colorOffset);
             }
             if (attributes.has(Attribute::Intensity)) {
-                intensities[i] = load<std::uint16_t>(record + m_layout.intensityOffset);
+                out.intensities[at] = load<std::uint16_t>(record + m_layout.intensityOffset);
             }
         }
         cloud.publish(end);

@@ -43,7 +43,8 @@ public:
     // count differs), UnsupportedFeature (another version, sort depth, attribute bit, or a
     // big-endian file), MalformedHeader (header checksum, record size, non-finite cube, reserved
     // bytes), NoPoints (count 0).
-    explicit OmsReader(const std::string& path);
+    // `storage` is how cloud() keeps positions and colours.
+    explicit OmsReader(const std::string& path, PointStorage storage = PointStorage::Exact);
 
     const OmsInfo& info() const { return m_info; }
     std::shared_ptr<SortedCloud> cloud() const { return m_cloud; }

@@ -96,9 +96,7 @@ void OmsWriter::append(const SortedCloud& cloud, std::size_t begin, std::size_t 
         fail("appending [" + std::to_string(begin) + ", " + std::to_string(end) + ") exceeds the " +
              std::to_string(m_pointCount) + " points declared at open()");
     }
-    const auto positions = cloud.positions();
     const auto normals = cloud.normals();
-    const auto colors = cloud.colors();
     const auto intensities = cloud.intensities();
     const std::size_t recordBytes = m_layout.bytes;
     const std::size_t recordsPerBlock = std::max<std::size_t>(1, kBlockBytes / recordBytes);
@@ -107,7 +105,7 @@ void OmsWriter::append(const SortedCloud& cloud, std::size_t begin, std::size_t 
         m_block.resize((blockEnd - blockBegin) * recordBytes);
         std::uint8_t* record = m_block.data();
         for (std::size_t i = blockBegin; i < blockEnd; ++i, record += recordBytes) {
-            const glm::vec3& p = positions[i];
+            const glm::vec3 p = cloud.position(i);
             // The reader recomputes codes from the stored positions, so that is what must be
             // in order (SortedCloud::code does the same).
             const morton::Code code = morton::encodeUnit(p.x, p.y, p.z);
@@ -121,7 +119,7 @@ void OmsWriter::append(const SortedCloud& cloud, std::size_t begin, std::size_t 
                 store(record + m_layout.normalOffset, normals[i]);
             }
             if (m_attributes.has(Attribute::Color)) {
-                store(record + m_layout.colorOffset, colors[i]);
+                store(record + m_layout.colorOffset, cloud.color(i));
             }
             if (m_attributes.has(Attribute::Intensity)) {
                 store(record + m_layout.intensityOffset, intensities[i]);

@@ -147,7 +147,7 @@ PotreeExportSummary exportPotree(const Hierarchy& hierarchy, const std::string& 
                 offsets[i] = octree.bytesWritten();
                 for (std::uint32_t p = 0; p < node.pointCount; ++p) {
                     const std::uint32_t index = node.heldPoint(p);
-                    const glm::vec3& unit = cloud.positions()[index];
+                    const glm::vec3 unit = cloud.position(index);
                     for (int axis = 0; axis < 3; ++axis) {
                         const std::int32_t stored = quantize(unit[axis]);
                         store(record.data() + 4 * axis, stored);
@@ -159,7 +159,7 @@ PotreeExportSummary exportPotree(const Hierarchy& hierarchy, const std::string& 
                     if (rgb) {
                         for (int c = 0; c < 3; ++c) {
                             const auto value =
-                                static_cast<std::uint16_t>(cloud.colors()[index][c] * 257u);
+                                static_cast<std::uint16_t>(cloud.color(index)[c] * 257u);
                             store(record.data() + at + 2 * c, value);
                             rgbMin[c] = std::min(rgbMin[c], value);
                             rgbMax[c] = std::max(rgbMax[c], value);

@@ -109,10 +109,9 @@ CellEstimate estimateCell(const SplatScratch::Moments& m, double density, double
 // Splits the held points into the fine cells of `fineLevel` and sums their moments relative to
 // `origin`; a cell's key is its code at fineLevel. `pointAt(i)` is the cloud index of the i-th
 // held point.
-template <typename PointAt>
-void sumCells(const SortedCloud& cloud, std::uint32_t count, int fineLevel,
-              const glm::dvec3& origin, PointAt pointAt, SplatScratch& scratch) {
-    const glm::vec3* positions = cloud.positions().data();
+template <typename Positions, typename PointAt>
+void sumCellsOf(const Positions& positions, std::uint32_t count, int fineLevel,
+                const glm::dvec3& origin, PointAt pointAt, SplatScratch& scratch) {
     const int shift = 3 * (morton::kMaxLevel - fineLevel);
     const auto cellCode = [&](const glm::vec3& p) {
         return morton::encodeUnit(p.x, p.y, p.z) >> shift;
@@ -124,12 +123,12 @@ void sumCells(const SortedCloud& cloud, std::uint32_t count, int fineLevel,
     // would force them through memory). Points are tested against the cell's box (no bit
     // interleaving); a cell's code is computed once, when it starts.
     SplatScratch::Moments current;
-    const glm::vec3& firstPoint = positions[pointAt(0)];
+    const glm::vec3 firstPoint = positions[pointAt(0)];
     UnitCellBox currentBox = UnitCellBox::of(firstPoint, fineLevel);
     morton::Code currentCode = cellCode(firstPoint);
     std::uint32_t currentFirst = 0;
     for (std::uint32_t i = 0; i < count; ++i) {
-        const glm::vec3& p = positions[pointAt(i)];
+        const glm::vec3 p = positions[pointAt(i)];
         if (!currentBox.contains(p)) {
             scratch.cellKeys.push_back(currentCode);
             scratch.cellFirst.push_back(currentFirst);
@@ -147,17 +146,24 @@ void sumCells(const SortedCloud& cloud, std::uint32_t count, int fineLevel,
     scratch.cellFirst.push_back(count);
 }
 
+template <typename PointAt>
+void sumCells(const SortedCloud& cloud, std::uint32_t count, int fineLevel,
+              const glm::dvec3& origin, PointAt pointAt, SplatScratch& scratch) {
+    cloud.visitPositions([&](const auto& positions) {
+        sumCellsOf(positions, count, fineLevel, origin, pointAt, scratch);
+    });
+}
+
 // Moments of at most kRegionSamples evenly spaced points of the region (the parents'
 // stratified picks).
 SplatScratch::Moments regionMoments(const SortedCloud& cloud, const SparseSplatRegion& region,
                                     const glm::dvec3& origin) {
-    const glm::vec3* positions = cloud.positions().data();
     std::array<std::uint32_t, kRegionSamples> picks;
     const std::span<std::uint32_t> samples(picks.data(), std::min(region.count, kRegionSamples));
     sampleRange(region.begin, region.count, samples);
     SplatScratch::Moments moments;
     for (const std::uint32_t point : samples) {
-        const glm::vec3& p = positions[point];
+        const glm::vec3 p = cloud.position(point);
         moments.add(p.x - origin.x, p.y - origin.y, p.z - origin.z);
     }
     return moments;

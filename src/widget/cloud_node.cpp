@@ -75,12 +75,13 @@ void CloudNode::updateBounds(std::size_t maxPoints) {
         m_boundsMax = glm::dvec3(0.0);
     }
     const std::size_t end = std::min(published, m_boundsScanned + maxPoints);
-    const auto positions = cloud.positions();
     glm::vec3 low(m_boundsMin), high(m_boundsMax);
-    for (std::size_t i = m_boundsScanned; i < end; ++i) {
-        low = glm::min(low, positions[i]);
-        high = glm::max(high, positions[i]);
-    }
+    cloud.visitPositions([&](const auto& positions) {
+        for (std::size_t i = m_boundsScanned; i < end; ++i) {
+            low = glm::min(low, glm::vec3(positions[i]));
+            high = glm::max(high, glm::vec3(positions[i]));
+        }
+    });
     m_boundsMin = glm::dvec3(low);
     m_boundsMax = glm::dvec3(high);
     m_boundsScanned = end;

@@ -37,24 +37,23 @@ void packNodeVertices(const Hierarchy& hierarchy, const OctreeNode& node,
     const NodeSplats& splats = scratch.splats;
     const bool estimatedNormals = !splats.normals.empty();
     const auto inputNormals = cloud.normals();
-    const auto positions = cloud.positions();
-    const auto colors = cloud.colors();
     const auto intensities = cloud.intensities();
-    const bool hasColor = !colors.empty();
+    const bool hasColor = cloud.hasColors();
     const bool hasIntensity = !intensities.empty();
 
     out.resize(node.pointCount);
     for (std::uint32_t i = 0; i < node.pointCount; ++i) {
         const std::uint32_t point = node.heldPoint(i);
         PointVertex& vertex = out[i];
-        const glm::vec3& p = positions[point];
+        const glm::vec3 p = cloud.position(point);
         vertex.x = p.x;
         vertex.y = p.y;
         vertex.z = p.z;
         if (hasColor) {
-            vertex.r = colors[point].r;
-            vertex.g = colors[point].g;
-            vertex.b = colors[point].b;
+            const glm::u8vec3 c = cloud.color(point);
+            vertex.r = c.r;
+            vertex.g = c.g;
+            vertex.b = c.b;
         } else {
             vertex.r = vertex.g = vertex.b = 255;
         }

@@ -128,6 +128,26 @@ void TestMainWindowGL::openingASharedFileBuildsAndFillsThePanels() {
         QCOMPARE(service->sourceReads(), 1u);
         QCOMPARE(levels->rowCount(), 10);
 
+        // The packed point store, chosen in the panel, applies to the next open: the same
+        // hierarchy in less memory, and the panel's summary says which store it is.
+        const auto exact = finished.at(1).at(0).value<PipelineResult>(); // depth 9, exact
+        auto* storeCombo = window.buildPanel()->findChild<QComboBox*>(QStringLiteral("storeCombo"));
+        QVERIFY(storeCombo != nullptr);
+        storeCombo->setCurrentIndex(1);
+        QCOMPARE(window.buildPanel()->pipelineOptions().storage, PointStorage::Packed);
+        window.openFile(path);
+        QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 3, kBuildTimeoutMs);
+        QTRY_VERIFY(!service->busy());
+        const auto packed = finished.last().at(0).value<PipelineResult>();
+        QVERIFY(packed.stats.complete);
+        QCOMPARE(packed.stats.pointStorage, PointStorage::Packed);
+        QCOMPARE(exact.stats.pointStorage, PointStorage::Exact);
+        QCOMPARE(packed.stats.totalNodes(), exact.stats.totalNodes());
+        QVERIFY(packed.stats.bytesResident() < exact.stats.bytesResident());
+        auto* summary = window.cutPanel()->findChild<QLabel*>(QStringLiteral("summaryLabel"));
+        QVERIFY(summary != nullptr);
+        QTRY_VERIFY(summary->text().contains(QStringLiteral("(packed points)")));
+
         // Screenshot of the view.
         const QString shot = dir.filePath(QStringLiteral("shot.png"));
         QVERIFY(window.saveScreenshot(shot));
@@ -138,6 +158,7 @@ void TestMainWindowGL::openingASharedFileBuildsAndFillsThePanels() {
     MainWindow again;
     QCOMPARE(again.recentFiles().value(0), path);
     QCOMPARE(again.buildPanel()->pipelineOptions().build.maxLevel, 9);
+    QCOMPARE(again.buildPanel()->pipelineOptions().storage, PointStorage::Packed);
 }
 
 void TestMainWindowGL::malformedFileShowsANamedErrorAndTheAppStaysUsable() {

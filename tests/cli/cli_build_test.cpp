@@ -99,5 +99,39 @@ TEST(CliBuild, PaperCollapseCountsDroppedPointsAndBadOptionsExitTwo) {
     EXPECT_EQ(runProcess(OMICRON_CLI_PATH, {"build", path, "--ratio", "1.5"}).exitCode, 2);
 }
 
+std::uint64_t jsonCount(const std::string& json, const std::string& key) {
+    std::smatch match;
+    if (!std::regex_search(json, match, std::regex("\"" + key + "\":(\\d+)"))) {
+        ADD_FAILURE() << "no " << key << " in " << json;
+        return 0;
+    }
+    return std::stoull(match[1]);
+}
+
+// --store packed, from unsorted input and from a .oms: the same levels as exact, the cloud in
+// fewer bytes, the store named in the JSON; a bad store name is a usage error.
+TEST(CliBuild, PackedStoreBuildsTheSameLevelsInFewerBytes) {
+    OMICRON_REQUIRE_SHARED_FILE(path, "autzen_trim.ply");
+    test::TempDir dir;
+    const std::string oms = dir.file("sorted.oms");
+    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"sort", path, oms}).exitCode, 0);
+    for (const std::string& input : {path, oms}) {
+        const auto exact = runProcess(OMICRON_CLI_PATH, {"build", input, "--json"});
+        const auto packed =
+            runProcess(OMICRON_CLI_PATH, {"build", input, "--store", "packed", "--json"});
+        ASSERT_EQ(exact.exitCode, 0) << exact.err;
+        ASSERT_EQ(packed.exitCode, 0) << packed.err;
+        EXPECT_NE(exact.out.find("\"point_storage\":\"exact\""), std::string::npos) << exact.out;
+        EXPECT_NE(packed.out.find("\"point_storage\":\"packed\""), std::string::npos)
+            << packed.out;
+        EXPECT_EQ(levelCounts(packed.out), levelCounts(exact.out)) << input;
+        EXPECT_LT(jsonCount(packed.out, "cloud_bytes") * 3, jsonCount(exact.out, "cloud_bytes") * 2)
+            << input;
+    }
+    const auto bad = runProcess(OMICRON_CLI_PATH, {"build", path, "--store", "zip"});
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.err.find("--store takes exact or packed"), std::string::npos) << bad.err;
+}
+
 } // namespace
 } // namespace omicron

@@ -121,9 +121,11 @@ struct BuildResult {
 
 // Through the real incremental sorter, ranges of `rangePoints` (as in production).
 inline BuildResult buildSynthetic(const SyntheticCloud& cloud, const BuildOptions& options,
-                                  std::size_t rangePoints = 4096, int sortChunks = 8) {
+                                  std::size_t rangePoints = 4096, int sortChunks = 8,
+                                  PointStorage storage = PointStorage::Exact) {
     SortOptions sortOptions;
     sortOptions.chunks = sortChunks;
+    sortOptions.storage = storage;
     sortOptions.batchPoints = rangePoints;
     IncrementalMortonSorter sorter(cloud.info, sortOptions);
     sorter.add(cloud.points);
@@ -137,10 +139,12 @@ inline BuildResult buildSynthetic(const SyntheticCloud& cloud, const BuildOption
 }
 
 // Pipeline 1 exactly as the CLI runs it: open, read + sort, build while ranges arrive.
-inline BuildResult buildFile(const std::string& path, const BuildOptions& options) {
+inline BuildResult buildFile(const std::string& path, const BuildOptions& options,
+                             PointStorage storage = PointStorage::Exact) {
     auto reader = openPointCloud(path);
     BuildResult result;
     SortOptions sortOptions;
+    sortOptions.storage = storage;
     sortPointCloud(
         *reader, sortOptions,
         [&](const SortedCloud& cloud, std::size_t begin, std::size_t end) {
@@ -264,7 +268,8 @@ private:
     std::uint64_t m_hash = 0xcbf29ce484222325ull;
 };
 
-inline std::uint64_t fingerprint(const Hierarchy& hierarchy) {
+// Every node's structure and held points, and (withSplats) the splats a renderer would draw.
+inline std::uint64_t fingerprint(const Hierarchy& hierarchy, bool withSplats = true) {
     Fingerprint print;
     for (int level = 0; level <= hierarchy.maxLevel(); ++level) {
         print.add(hierarchy.nodeCount(level));
@@ -282,6 +287,9 @@ inline std::uint64_t fingerprint(const Hierarchy& hierarchy) {
                 print.add(node.heldPoint(p));
             }
         }
+    }
+    if (!withSplats) {
+        return print.value();
     }
     // The splat attributes a renderer would draw every node with.
     NodeSplats splats;
