@@ -10,10 +10,6 @@ std::uint64_t BuildStatistics::totalNodes() const {
     return total;
 }
 
-std::size_t sortedCloudBytes(const SortedCloud& cloud) {
-    return cloud.bytesResident();
-}
-
 void recordMilestones(std::array<double, 10>& milestones, std::uint64_t inserted,
                       std::uint64_t total, double seconds) {
     for (std::size_t decile = 0; decile < milestones.size(); ++decile) {

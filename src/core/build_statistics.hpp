@@ -56,8 +56,6 @@ struct BuildStatistics {
     std::uint64_t totalNodes() const;
 };
 
-// Bytes of the SortedCloud's arrays at full capacity.
-std::size_t sortedCloudBytes(const SortedCloud& cloud);
 
 // Records, in `milestones`, `seconds` for every decile that `inserted` of `total` points
 // reached and that was not recorded yet.

@@ -134,7 +134,7 @@ HierarchyBuilder::HierarchyBuilder(std::shared_ptr<const SortedCloud> cloud,
       m_worker(std::make_unique<Worker>(options.threads)),
       m_start(std::chrono::steady_clock::now()) {
     m_stats.levels.resize(static_cast<std::size_t>(options.maxLevel) + 1);
-    m_stats.cloudBytes = sortedCloudBytes(*m_cloud);
+    m_stats.cloudBytes = m_cloud->bytesResident();
     m_stats.pointStorage = m_cloud->storage();
     m_publishedStats = m_stats;
     m_thread = std::thread([this] { run(); });
@@ -505,7 +505,7 @@ void HierarchyBuilder::publishStatistics() {
         levelStats.placeholdersPending = static_cast<std::uint64_t>(std::count_if(
             roots.begin(), roots.end(), [](const CutRoot& r) { return r.placeholder; }));
     }
-    m_stats.cloudBytes = sortedCloudBytes(*m_cloud); // a packed store grows with the input
+    m_stats.cloudBytes = m_cloud->bytesResident(); // a packed store grows with the input
     m_stats.nodeBytes = m_hierarchy->nodeBytes();
     m_stats.sampleBytes = m_hierarchy->sampleBytes();
     m_stats.splatBytes = m_hierarchy->splatBytes();

@@ -183,21 +183,13 @@ void PackedPointStore::append(std::span<const glm::vec3> positions,
     m_size += positions.size();
 
     // Keep the points of a short last block for the next append.
-    const std::size_t tail = m_size % kBlockPoints;
-    if (blocks == 1) {
-        m_tailPositions = std::move(headPositions);
-        m_tailColors = std::move(headColors);
-    } else {
-        m_tailPositions.assign(positions.end() - static_cast<std::ptrdiff_t>(tail),
-                               positions.end());
-        if (!colors.empty()) {
-            m_tailColors.assign(colors.end() - static_cast<std::ptrdiff_t>(tail), colors.end());
-        }
+    std::span<const glm::vec3> lastPositions;
+    std::span<const glm::u8vec3> lastColors;
+    if (m_size % kBlockPoints != 0) {
+        blockPoints(blocks - 1, lastPositions, lastColors);
     }
-    if (tail == 0) {
-        m_tailPositions.clear();
-        m_tailColors.clear();
-    }
+    m_tailPositions.assign(lastPositions.begin(), lastPositions.end());
+    m_tailColors.assign(lastColors.begin(), lastColors.end());
 }
 
 std::size_t PackedPointStore::bytesResident() const {

@@ -157,9 +157,9 @@ PotreeExportSummary exportPotree(const Hierarchy& hierarchy, const std::string& 
                     }
                     std::size_t at = 12;
                     if (rgb) {
+                        const glm::u8vec3 color = cloud.color(index);
                         for (int c = 0; c < 3; ++c) {
-                            const auto value =
-                                static_cast<std::uint16_t>(cloud.color(index)[c] * 257u);
+                            const auto value = static_cast<std::uint16_t>(color[c] * 257u);
                             store(record.data() + at + 2 * c, value);
                             rgbMin[c] = std::min(rgbMin[c], value);
                             rgbMax[c] = std::max(rgbMax[c], value);

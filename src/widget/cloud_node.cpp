@@ -78,8 +78,9 @@ void CloudNode::updateBounds(std::size_t maxPoints) {
     glm::vec3 low(m_boundsMin), high(m_boundsMax);
     cloud.visitPositions([&](const auto& positions) {
         for (std::size_t i = m_boundsScanned; i < end; ++i) {
-            low = glm::min(low, glm::vec3(positions[i]));
-            high = glm::max(high, glm::vec3(positions[i]));
+            const glm::vec3 p = positions[i];
+            low = glm::min(low, p);
+            high = glm::max(high, p);
         }
     });
     m_boundsMin = glm::dvec3(low);

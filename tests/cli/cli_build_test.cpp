@@ -76,11 +76,7 @@ TEST_P(CliBuildSharedData, LevelsMatchABruteForceOctree) {
 INSTANTIATE_TEST_SUITE_P(Files, CliBuildSharedData,
                          ::testing::Values("bunny.ply", "autzen_trim.las", "lion.ply",
                                            "sorvilier.ply", "indoor.ply", "dragon.ply"),
-                         [](const auto& info) {
-                             std::string name = info.param;
-                             std::replace(name.begin(), name.end(), '.', '_');
-                             return name;
-                         });
+                         test::FileParamName());
 
 TEST(CliBuild, PaperCollapseCountsDroppedPointsAndBadOptionsExitTwo) {
     OMICRON_REQUIRE_SHARED_FILE(path, "bunny.ply");

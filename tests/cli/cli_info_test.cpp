@@ -101,11 +101,7 @@ INSTANTIATE_TEST_SUITE_P(Files, CliInfoSharedData,
                                            SharedFileCount{"indoor.ply", "808042"},
                                            SharedFileCount{"dragon.ply", "437645"},
                                            SharedFileCount{"autzen_south.ply", "4844261"}),
-                         [](const auto& info) {
-                             std::string name = info.param.name;
-                             std::replace(name.begin(), name.end(), '.', '_');
-                             return name;
-                         });
+                         [](const auto& info) { return test::fileParamName(info.param.name); });
 
 TEST(CliInfo, UnderstandsSortedStreams) {
     OMICRON_REQUIRE_SHARED_FILE(input, "autzen_trim.las");

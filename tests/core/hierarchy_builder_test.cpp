@@ -407,11 +407,7 @@ TEST_P(HierarchyBuilderSharedData, MatchesTheReferenceOctreeAndHoldsEveryPoint) 
 INSTANTIATE_TEST_SUITE_P(EveryFile, HierarchyBuilderSharedData,
                          testing::Values("bunny.ply", "dragon.ply", "lion.ply", "sorvilier.ply",
                                          "indoor.ply", "autzen_trim.ply", "autzen_trim.las"),
-                         [](const testing::TestParamInfo<const char*>& info) {
-                             std::string name = info.param;
-                             std::replace(name.begin(), name.end(), '.', '_');
-                             return name;
-                         });
+                         test::FileParamName());
 
 TEST(HierarchyBuilderSharedData, LeafCollapseOnARealScan) {
     OMICRON_REQUIRE_SHARED_FILE(path, "lion.ply");

@@ -306,11 +306,7 @@ INSTANTIATE_TEST_SUITE_P(Files, MortonSorterSharedData,
                          ::testing::Values("bunny.ply", "autzen_trim.ply", "autzen_trim.las",
                                            "lion.ply", "sorvilier.ply", "indoor.ply", "dragon.ply",
                                            "autzen_south.ply"),
-                         [](const auto& info) {
-                             std::string name = info.param;
-                             std::replace(name.begin(), name.end(), '.', '_');
-                             return name;
-                         });
+                         test::FileParamName());
 
 } // namespace
 } // namespace omicron

@@ -253,11 +253,7 @@ INSTANTIATE_TEST_SUITE_P(EveryFile, PackedCloudSharedData,
                          testing::Values("bunny.ply", "dragon.ply", "lion.ply", "sorvilier.ply",
                                          "indoor.ply", "autzen_trim.ply", "autzen_trim.las",
                                          "autzen_south.ply"),
-                         [](const testing::TestParamInfo<const char*>& info) {
-                             std::string name = info.param;
-                             std::replace(name.begin(), name.end(), '.', '_');
-                             return name;
-                         });
+                         test::FileParamName());
 
 // The memory target, as the CLI and build_bench measure it: paper leaf collapse, ratio
 // 0.2, depth 7, everything resident (cloud, nodes, samples) against the file's size.

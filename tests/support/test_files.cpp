@@ -1,5 +1,6 @@
 #include "test_files.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <fstream>
 #include <stdexcept>
@@ -25,6 +26,11 @@ TempDir::~TempDir() {
 std::string sharedDataFile(const std::string& name) {
     const std::filesystem::path path = std::filesystem::path(OMICRON_SHARED_DATA_DIR) / name;
     return std::filesystem::is_regular_file(path) ? path.string() : std::string();
+}
+
+std::string fileParamName(std::string fileName) {
+    std::replace(fileName.begin(), fileName.end(), '.', '_');
+    return fileName;
 }
 
 void writeBytes(const std::string& path, const std::vector<std::uint8_t>& bytes) {

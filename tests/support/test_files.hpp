@@ -33,6 +33,15 @@ std::string sharedDataFile(const std::string& name);
         GTEST_SKIP() << "shared data file " << (NAME) << " is absent (../shared/data); skipped";   \
     }
 
+// A parameterised test's name for a data file name: "bunny.ply" -> "bunny_ply".
+std::string fileParamName(std::string fileName);
+// The same as INSTANTIATE_TEST_SUITE_P's name generator, for tests parameterised by file name.
+struct FileParamName {
+    template <typename ParamInfo> std::string operator()(const ParamInfo& info) const {
+        return fileParamName(info.param);
+    }
+};
+
 void writeBytes(const std::string& path, const std::vector<std::uint8_t>& bytes);
 void writeText(const std::string& path, const std::string& text);
 std::vector<std::uint8_t> readBytes(const std::string& path);
