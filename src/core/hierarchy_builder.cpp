@@ -15,7 +15,6 @@
 #include <tbb/task_arena.h>
 
 namespace omicron {
-
 namespace {
 
 // Input cut into leaves per pass, at most: bounds the latency of a pass (and of cancel()),
@@ -39,11 +38,11 @@ struct WorklistResult {
     // The drafts' samples. The commit hands the whole buffer to the hierarchy (no copy on
     // the master thread), so the worker trims it to size first.
     std::vector<std::uint32_t> samples;
-    const std::uint32_t* adoptedSamples = nullptr; // where the hierarchy keeps them
+    bool ownsSplitGroup = false; // its last group continued into the next worklist
     void clear() {
         drafts.clear();
         samples.clear();
-        adoptedSamples = nullptr;
+        ownsSplitGroup = false;
     }
 };
 
@@ -119,8 +118,6 @@ public:
 
     tbb::task_arena arena;
     std::vector<WorklistResult> results;
-    WorklistResult merged;
-    std::vector<std::pair<WorklistResult*, std::size_t>> order;
     std::vector<LeafRun> runs;
     std::vector<std::uint32_t> groupOf;  // run -> its sibling group
     std::vector<std::size_t> groupFirst; // group -> its first run (+ one past the last)
@@ -371,12 +368,32 @@ void HierarchyBuilder::fixLevel(int level) {
     if (worker.results.size() < worklists) {
         worker.results.resize(worklists);
     }
+    // A worklist owns the sibling groups whose first root it holds. A group cut by a worklist
+    // boundary would give the paper's duplicate parents, one per worklist, each with part of
+    // the children; here the owner takes the whole group, reading up to 7 roots past its end,
+    // and the next worklist skips them: the duplicates are merged where they would arise, in
+    // parallel, and no child is lost or moved afterwards.
+    const auto sameParent = [&](std::size_t a, std::size_t b) {
+        return (pending[a].code >> 3) == (pending[b].code >> 3);
+    };
     const auto runWorklist = [&](std::size_t w) {
         WorklistResult& result = worker.results[w];
         result.clear();
-        const std::size_t first = w * worklistSize;
-        const auto slice = pending.subspan(first, std::min(worklistSize, pending.size() - first));
-        forEachSiblingGroup(slice, [&](std::span<const CutRoot> group) {
+        std::size_t first = w * worklistSize;
+        std::size_t last = std::min(first + worklistSize, pending.size());
+        while (first > 0 && first < last && sameParent(first - 1, first)) {
+            ++first;
+        }
+        if (first == last) {
+            return; // the whole worklist continues a group owned by an earlier one
+        }
+        if (last < pending.size() && sameParent(last - 1, last)) {
+            result.ownsSplitGroup = true;
+            while (last < pending.size() && sameParent(last - 1, last)) {
+                ++last;
+            }
+        }
+        forEachSiblingGroup(pending.subspan(first, last - first), [&](std::span<const CutRoot> group) {
             draftParent(*m_hierarchy, m_cut, m_options, level - 1, group, result);
         });
         result.samples.shrink_to_fit();
@@ -395,63 +412,38 @@ void HierarchyBuilder::fixLevel(int level) {
     }
     m_stats.worklists += worklists;
 
-    // Join the results in order. A sibling group cut by a worklist boundary gave the same
-    // parent twice, each with part of the children: rebuild it once from the whole group.
-    worker.merged.clear();
-    auto& order = worker.order;
-    order.clear();
-    for (std::size_t w = 0; w < worklists; ++w) {
-        WorklistResult& result = worker.results[w];
-        for (std::size_t d = 0; d < result.drafts.size(); ++d) {
-            const morton::Code code = result.drafts[d].code();
-            if (order.empty() || order.back().first->drafts[order.back().second].code() != code) {
-                order.emplace_back(&result, d);
-                continue;
-            }
-            assert(d == 0); // groups are maximal within a worklist: only a boundary splits one
-            std::size_t groupBegin = w * worklistSize, groupEnd = w * worklistSize;
-            while (groupBegin > 0 && (pending[groupBegin - 1].code >> 3) == code) {
-                --groupBegin;
-            }
-            while (groupEnd < pending.size() && (pending[groupEnd].code >> 3) == code) {
-                ++groupEnd;
-            }
-            draftParent(*m_hierarchy, m_cut, m_options, level - 1,
-                        pending.subspan(groupBegin, groupEnd - groupBegin), worker.merged);
-            order.back() = {&worker.merged, worker.merged.drafts.size() - 1};
-            ++m_stats.duplicateParentsMerged;
-        }
-    }
-
-    // Commit in Morton order, then publish: no published node ever changes.
+    // Commit in Morton order (worklist by worklist), then publish: no published node changes.
     std::vector<CutRoot>& parents = worker.roots;
     parents.clear();
     LevelStatistics& parentLevel = m_stats.levels[level - 1];
-    worker.merged.samples.shrink_to_fit();
-    for (const auto& [result, d] : order) {
-        const ParentDraft& draft = result->drafts[d];
-        if (draft.risingPlaceholder) {
-            parents.push_back(draft.root);
-            continue;
+    for (std::size_t w = 0; w < worklists; ++w) {
+        WorklistResult& result = worker.results[w];
+        m_stats.duplicateParentsMerged += result.ownsSplitGroup ? 1 : 0;
+        const std::uint32_t* samples = nullptr;
+        if (!result.samples.empty()) {
+            // The result is not reused before the next level: its buffer may move out.
+            samples = m_hierarchy->adoptSamples(std::move(result.samples));
         }
-        OctreeNode node = draft.node;
-        if (draft.sampled) {
-            if (result->adoptedSamples == nullptr) {
-                // The result is not reused before the next level: its buffer may move out.
-                result->adoptedSamples = m_hierarchy->adoptSamples(std::move(result->samples));
+        for (const ParentDraft& draft : result.drafts) {
+            if (draft.risingPlaceholder) {
+                parents.push_back(draft.root);
+                continue;
             }
-            node.sampleIndices = result->adoptedSamples + draft.sampleOffset;
-        }
-        parents.push_back({node.code,
-                           static_cast<std::uint32_t>(m_hierarchy->appendNode(level - 1, node)),
-                           false});
-        ++parentLevel.nodes;
-        parentLevel.points += node.pointCount;
-        if (draft.substituted) {
-            ++parentLevel.leaves;
-            ++parentLevel.placeholdersSubstituted;
-            ++m_stats.placeholdersSubstituted;
-            m_stats.droppedPoints += node.coveredCount - node.pointCount;
+            OctreeNode node = draft.node;
+            if (draft.sampled) {
+                node.sampleIndices = samples + draft.sampleOffset;
+            }
+            parents.push_back(
+                {node.code, static_cast<std::uint32_t>(m_hierarchy->appendNode(level - 1, node)),
+                 false});
+            ++parentLevel.nodes;
+            parentLevel.points += node.pointCount;
+            if (draft.substituted) {
+                ++parentLevel.leaves;
+                ++parentLevel.placeholdersSubstituted;
+                ++m_stats.placeholdersSubstituted;
+                m_stats.droppedPoints += node.coveredCount - node.pointCount;
+            }
         }
     }
     m_hierarchy->publishNodes(level - 1);

@@ -9,11 +9,13 @@
 //      are not built: a renderer estimates them for the nodes it draws, splat_estimator.hpp);
 //   2. fix, level by level from maxLevel up: the roots that fix moves at this level are cut
 //      into worklists of `worklistSize` roots; oneTBB workers make the parent of each sibling
-//      group in their worklist. A group cut by a worklist boundary yields the same parent in
-//      two results: the master merges them (recomputing the parent from all its children, so
-//      no child is lost and the result equals a sequential fix) before anything is published,
-//      appends the parents in Morton order and publishes the level. The next level's worklists
-//      are cut again from the whole list, which merges the results that shrank going up.
+//      group in their worklist. A group cut by a worklist boundary would yield the paper's
+//      duplicate parents, one per worklist; instead the worklist holding the group's first
+//      root takes the whole group and the next one skips its rest, so the duplicates are
+//      merged in parallel where they arise (no child lost, and the parent equals a sequential
+//      fix's). The master appends the parents in Morton order and publishes the level. The
+//      next level's worklists are cut again from the whole list, which merges the results
+//      that shrank going up.
 //   3. multipass: after each level, if new input arrived and it promises more work than the
 //      next level holds, the pass stops there and a new pass starts from maxLevel with the
 //      new leaves (the levels left behind are fixed by the new pass on its way up).
