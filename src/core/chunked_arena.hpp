@@ -41,6 +41,26 @@ public:
         return m_size++;
     }
 
+    // Writer only: appends `count` default elements (allocating their chunks) and returns the
+    // first one's index. The writer may have them filled through slot() by other threads,
+    // provided the filling happens-before the count that covers them is published.
+    std::size_t extend(std::size_t count) {
+        assert(count <= m_capacity - m_size);
+        const std::size_t first = m_size;
+        for (std::size_t chunk = (first + ChunkElements - 1) / ChunkElements;
+             chunk * ChunkElements < first + count; ++chunk) {
+            m_chunks[chunk] = std::make_unique<T[]>(ChunkElements);
+            ++m_chunksAllocated;
+        }
+        m_size += count;
+        return first;
+    }
+    // An element appended but not yet published, to fill.
+    T& slot(std::size_t index) {
+        assert(index < m_size);
+        return m_chunks[index / ChunkElements][index % ChunkElements];
+    }
+
     const T& operator[](std::size_t index) const {
         return m_chunks[index / ChunkElements][index % ChunkElements];
     }

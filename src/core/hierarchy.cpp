@@ -109,22 +109,31 @@ std::size_t Hierarchy::appendNode(int level, const OctreeNode& node) {
 
 void Hierarchy::publishNodes(int level) {
     Level& storage = *m_levels[level];
-    if (storage.published.load(std::memory_order_relaxed) != storage.nodes.size()) {
+    const std::size_t published = storage.published.load(std::memory_order_relaxed);
+    if (published != storage.nodes.size()) {
+#ifndef NDEBUG
+        // Nodes filled through builtNode() are checked here, before anyone can see them.
+        for (std::size_t i = published; i < storage.nodes.size(); ++i) {
+            assert(storage.nodes[i].level() == level);
+            assert(i == 0 || storage.nodes[i - 1].code < storage.nodes[i].code);
+        }
+#endif
         storage.published.store(storage.nodes.size(), std::memory_order_release);
         bumpEpoch();
     }
 }
 
-void Hierarchy::appendInsertion(const CutInsertion& insertion) {
-    auto& entries = m_insertions.entries;
-    assert(entries.size() == 0 || morton::span(entries[entries.size() - 1].leafCode, m_maxLevel) <
-                                      morton::span(insertion.leafCode, m_maxLevel));
-    entries.push_back(insertion);
-}
-
 void Hierarchy::publishInsertions() {
-    if (m_insertions.published.load(std::memory_order_relaxed) != m_insertions.entries.size()) {
-        m_insertions.published.store(m_insertions.entries.size(), std::memory_order_release);
+    auto& entries = m_insertions.entries;
+    const std::size_t published = m_insertions.published.load(std::memory_order_relaxed);
+    if (published != entries.size()) {
+#ifndef NDEBUG
+        for (std::size_t i = std::max<std::size_t>(published, 1); i < entries.size(); ++i) {
+            assert(morton::span(entries[i - 1].leafCode, m_maxLevel) <
+                   morton::span(entries[i].leafCode, m_maxLevel));
+        }
+#endif
+        m_insertions.published.store(entries.size(), std::memory_order_release);
         bumpEpoch();
     }
 }

@@ -15,11 +15,14 @@
 #include <tbb/task_arena.h>
 
 namespace omicron {
+
 namespace {
 
 // Input cut into leaves per pass, at most: bounds the latency of a pass (and of cancel()),
 // so that a builder that fell behind still publishes in steps.
 constexpr std::size_t kMaxInsertPoints = std::size_t{1} << 18;
+// Leaves written per parallel task (a pass makes about a thousand).
+constexpr std::size_t kLeafFillGrain = 256;
 
 // What a worker makes of one sibling group, before the master publishes it.
 struct ParentDraft {
@@ -119,8 +122,6 @@ public:
     tbb::task_arena arena;
     std::vector<WorklistResult> results;
     std::vector<LeafRun> runs;
-    std::vector<std::uint32_t> groupOf;  // run -> its sibling group
-    std::vector<std::size_t> groupFirst; // group -> its first run (+ one past the last)
     std::vector<CutRoot> roots;
 };
 
@@ -276,67 +277,71 @@ void HierarchyBuilder::insertInput(std::size_t available, bool inputEnded) {
                                               groupLevel, kMaxInsertPoints);
         m_inputBacklog = insertableEnd(positions, cut, available, inputEnded, groupLevel,
                                        kMaxInsertPoints) > cut;
-        findLeafRuns(positions, m_insertedEnd, cut, maxLevel, runs);
+        findLeafRuns(positions, m_cloud->blockCodes(available), m_insertedEnd, cut, maxLevel,
+                     runs);
         return cut;
     });
     if (end == m_insertedEnd) {
         return;
     }
 
-    // Sibling groups: runs [groupFirst[g], groupFirst[g + 1]).
-    std::vector<std::uint32_t>& groupOf = worker.groupOf;
-    std::vector<std::size_t>& groupFirst = worker.groupFirst;
-    groupOf.resize(runs.size());
-    groupFirst.clear();
-    for (std::size_t i = 0; i < runs.size(); ++i) {
-        if (i == 0 || (runs[i - 1].code >> 3) != (runs[i].code >> 3)) {
-            groupFirst.push_back(i);
-        }
-        groupOf[i] = static_cast<std::uint32_t>(groupFirst.size() - 1);
-    }
-    groupFirst.push_back(runs.size());
-    const auto groupSize = [&](std::size_t run) {
-        return groupFirst[groupOf[run] + 1] - groupFirst[groupOf[run]];
-    };
-    const bool collapse = m_options.collapse != LeafCollapse::Off;
-    const auto collapsed = [&](std::size_t run) {
-        return collapse && groupSize(run) == 1;
-    };
-
+    // What each run becomes, in order on the master (cheap: no memory beyond the runs): a
+    // leaf with the next node index or, under leaf collapse, a placeholder when it has no
+    // sibling (the range holds whole sibling groups, so its neighbours tell).
     std::vector<CutRoot>& roots = worker.roots;
-    roots.clear();
-    LevelStatistics& leafLevel = m_stats.levels[maxLevel];
+    roots.resize(runs.size());
+    const bool collapse = m_options.collapse != LeafCollapse::Off;
+    const std::size_t firstLeaf = m_hierarchy->builtNodeCount(maxLevel);
+    std::size_t leaves = 0;
+    std::uint64_t leafPoints = 0;
     for (std::size_t i = 0; i < runs.size(); ++i) {
         const LeafRun& run = runs[i];
-        if (collapsed(i)) {
-            const morton::Code leafCode = run.code >> 3;
-            const std::uint32_t id = m_cut.addPlaceholder({leafCode, run.begin, run.count});
-            roots.push_back({morton::span(leafCode, maxLevel), id, true});
-            ++m_stats.placeholdersCreated;
-            ++m_stats.collapsedLeaves;
+        const morton::Code parent = run.code >> 3;
+        if (collapse && (i == 0 || (runs[i - 1].code >> 3) != parent) &&
+            (i + 1 == runs.size() || (runs[i + 1].code >> 3) != parent)) {
+            const std::uint32_t id = m_cut.addPlaceholder({parent, run.begin, run.count});
+            roots[i] = {morton::span(parent, maxLevel), id, true};
             continue;
         }
-        OctreeNode leaf;
-        leaf.code = run.code;
-        leaf.coveredBegin = run.begin;
-        leaf.coveredCount = run.count;
-        leaf.pointCount = run.count;
-        leaf.flags = static_cast<std::uint8_t>(NodeFlag::Leaf);
-        roots.push_back(
-            {run.code, static_cast<std::uint32_t>(m_hierarchy->appendNode(maxLevel, leaf)), false});
-        ++leafLevel.nodes;
-        ++leafLevel.leaves;
-        leafLevel.points += run.count;
+        roots[i] = {run.code, static_cast<std::uint32_t>(firstLeaf + leaves), false};
+        ++leaves;
+        leafPoints += run.count;
     }
-    m_hierarchy->publishNodes(maxLevel);
-    // The render front's hand-off (front.hpp): what is concatenated, in the same span order,
-    // naming the leaf itself (a collapsed leaf is not a node yet). Published after the leaves
-    // so that an entry's maxLevel leaf is always published when the entry is.
+    LevelStatistics& leafLevel = m_stats.levels[maxLevel];
+    leafLevel.nodes += leaves;
+    leafLevel.leaves += leaves;
+    leafLevel.points += leafPoints;
+    m_stats.placeholdersCreated += runs.size() - leaves;
+    m_stats.collapsedLeaves += runs.size() - leaves;
+
+    // The leaves and the render front's hand-off (front.hpp): one insertion entry per run, in
+    // the same span order, naming the leaf itself (a collapsed leaf is not a node yet). Written
+    // in parallel (fresh memory: the writes and their page faults are the cost), published
+    // leaves first, so that an entry's maxLevel leaf is always published when the entry is.
+    m_hierarchy->extendNodes(maxLevel, leaves);
+    const std::size_t firstInsertion = m_hierarchy->extendInsertions(runs.size());
     const auto publishedAt = std::chrono::steady_clock::now();
-    for (std::size_t i = 0; i < runs.size(); ++i) {
-        const morton::Code leafCode = collapsed(i) ? runs[i].code >> 3 : runs[i].code;
-        m_hierarchy->appendInsertion({leafCode, runs[i].begin, runs[i].count, publishedAt});
-    }
+    const auto fill = [&](std::size_t i) {
+        const LeafRun& run = runs[i];
+        const CutRoot& root = roots[i];
+        if (!root.placeholder) {
+            OctreeNode& leaf = m_hierarchy->builtNode(maxLevel, root.index);
+            leaf.code = run.code;
+            leaf.coveredBegin = run.begin;
+            leaf.coveredCount = run.count;
+            leaf.pointCount = run.count;
+            leaf.flags = static_cast<std::uint8_t>(NodeFlag::Leaf);
+        }
+        m_hierarchy->builtInsertion(firstInsertion + i) = {
+            root.placeholder ? run.code >> 3 : run.code, run.begin, run.count, publishedAt};
+    };
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, runs.size(), kLeafFillGrain),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                              fill(i);
+                          }
+                      });
+    m_hierarchy->publishNodes(maxLevel);
     m_hierarchy->publishInsertions();
     m_cut.concatenate(roots);
     m_insertedEnd = end;

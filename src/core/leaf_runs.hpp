@@ -8,6 +8,7 @@
 // PositionView (either point store); the span overloads read a plain array.
 #pragma once
 
+#include "block_codes.hpp"
 #include "morton.hpp"
 #include "position_views.hpp"
 
@@ -35,10 +36,12 @@ std::size_t endOfRun(const Positions& positions, std::size_t begin, std::size_t 
 template <PositionView Positions>
 std::size_t startOfRun(const Positions& positions, std::size_t last, int level);
 
-// Appends to `runs` the leaves at maxLevel of positions[begin, end) (in parallel blocks).
+// Appends to `runs` the leaves at maxLevel of positions[begin, end) (in parallel blocks),
+// reading the positions only where `index` (the cloud's block codes, block_codes.hpp; covering
+// at least [0, end), or empty) says a cell changes.
 template <PositionView Positions>
-void findLeafRuns(const Positions& positions, std::size_t begin, std::size_t end, int maxLevel,
-                  std::vector<LeafRun>& runs);
+void findLeafRuns(const Positions& positions, BlockCodes index, std::size_t begin,
+                  std::size_t end, int maxLevel, std::vector<LeafRun>& runs);
 
 // How far [begin, available) may be cut into leaves now, taking at most about `limit` points:
 // the returned end never splits a group of points sharing their cell at `groupLevel` (a leaf,
@@ -51,8 +54,8 @@ std::size_t insertableEnd(const Positions& positions, std::size_t begin, std::si
 #define OMICRON_LEAF_RUNS_EXTERN(Positions)                                                      \
     extern template std::size_t endOfRun(const Positions&, std::size_t, std::size_t, int);      \
     extern template std::size_t startOfRun(const Positions&, std::size_t, int);                 \
-    extern template void findLeafRuns(const Positions&, std::size_t, std::size_t, int,          \
-                                      std::vector<LeafRun>&);                                   \
+    extern template void findLeafRuns(const Positions&, BlockCodes, std::size_t, std::size_t,   \
+                                      int, std::vector<LeafRun>&);                              \
     extern template std::size_t insertableEnd(const Positions&, std::size_t, std::size_t, bool, \
                                               int, std::size_t);
 OMICRON_LEAF_RUNS_EXTERN(ExactPositions)
@@ -67,9 +70,10 @@ inline std::size_t endOfRun(std::span<const glm::vec3> positions, std::size_t be
 inline std::size_t startOfRun(std::span<const glm::vec3> positions, std::size_t last, int level) {
     return startOfRun(ExactPositions{positions.data()}, last, level);
 }
-inline void findLeafRuns(std::span<const glm::vec3> positions, std::size_t begin,
-                         std::size_t end, int maxLevel, std::vector<LeafRun>& runs) {
-    findLeafRuns(ExactPositions{positions.data()}, begin, end, maxLevel, runs);
+inline void findLeafRuns(std::span<const glm::vec3> positions, BlockCodes index,
+                         std::size_t begin, std::size_t end, int maxLevel,
+                         std::vector<LeafRun>& runs) {
+    findLeafRuns(ExactPositions{positions.data()}, index, begin, end, maxLevel, runs);
 }
 inline std::size_t insertableEnd(std::span<const glm::vec3> positions, std::size_t begin,
                                  std::size_t available, bool inputEnded, int groupLevel,

@@ -27,7 +27,7 @@ void ObliqueCut::concatenate(std::span<const CutRoot> leaves) {
     if (leaves.empty()) {
         return;
     }
-    std::vector<CutRoot>& list = m_lists[m_maxLevel].entries;
+#ifndef NDEBUG
     morton::Code previous = m_delimiter;
     for (const CutRoot& leaf : leaves) {
         assert(morton::level(leaf.code) == m_maxLevel);
@@ -35,9 +35,11 @@ void ObliqueCut::concatenate(std::span<const CutRoot> leaves) {
         assert(!leaf.placeholder ||
                leaf.code == morton::span(m_placeholders[leaf.index].leafCode, m_maxLevel));
         previous = leaf.code;
-        list.push_back(leaf);
     }
-    m_delimiter = previous;
+#endif
+    std::vector<CutRoot>& list = m_lists[m_maxLevel].entries;
+    list.insert(list.end(), leaves.begin(), leaves.end());
+    m_delimiter = leaves.back().code;
 }
 
 void ObliqueCut::close() {

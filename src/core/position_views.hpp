@@ -14,20 +14,27 @@ namespace omicron {
 struct ExactPositions {
     const glm::vec3* data;
     const glm::vec3& operator[](std::size_t i) const { return data[i]; }
-    void prefetch(std::size_t i) const { __builtin_prefetch(data + i); }
+    // Asks for the cache lines of points [first, first + count).
+    void prefetch(std::size_t first, std::size_t count) const {
+        const char* begin = reinterpret_cast<const char*>(data + first);
+        const char* end = reinterpret_cast<const char*>(data + first + count);
+        for (const char* line = begin; line < end; line += 64) {
+            __builtin_prefetch(line);
+        }
+    }
 };
 
 // Positions decoded from the packed store (each access decodes one point).
 struct PackedPositions {
     const PackedPointStore* store;
     glm::vec3 operator[](std::size_t i) const { return store->position(i); }
-    void prefetch(std::size_t) const {}
+    void prefetch(std::size_t, std::size_t) const {}
 };
 
 template <typename T>
 concept PositionView = requires(const T& view, std::size_t i) {
     { view[i] } -> std::convertible_to<glm::vec3>;
-    view.prefetch(i);
+    view.prefetch(i, i);
 };
 
 } // namespace omicron

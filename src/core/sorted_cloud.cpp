@@ -24,7 +24,8 @@ SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffs
       m_capacity(capacity), m_positions(storage == PointStorage::Exact ? capacity : 0),
       m_normals(attributes.has(Attribute::Normal) ? capacity : 0),
       m_colors(storage == PointStorage::Exact && attributes.has(Attribute::Color) ? capacity : 0),
-      m_intensities(attributes.has(Attribute::Intensity) ? capacity : 0) {
+      m_intensities(attributes.has(Attribute::Intensity) ? capacity : 0),
+      m_blockCodes(order == CloudOrder::Morton ? blockCodeCount(capacity) : 0) {
     if (storage == PointStorage::Packed) {
         m_packed =
             std::make_unique<PackedPointStore>(capacity, attributes.has(Attribute::Color));
@@ -64,6 +65,12 @@ void SortedCloud::publish(std::size_t newSortedEnd) {
     }
     assert(m_order != CloudOrder::Morton || previous == 0 || newSortedEnd == previous ||
            code(previous - 1) <= code(previous));
+    if (m_blockCodes.size() != 0) {
+        for (std::size_t block = blockCodeCount(previous); block < blockCodeCount(newSortedEnd);
+             ++block) {
+            m_blockCodes[block] = code(block * kBlockCodePoints);
+        }
+    }
     m_sortedEnd.store(newSortedEnd, std::memory_order_release);
 }
 
@@ -76,7 +83,8 @@ void SortedCloud::markComplete() {
 
 std::size_t SortedCloud::bytesResident() const {
     return positions().size_bytes() + normals().size_bytes() + colors().size_bytes() +
-           intensities().size_bytes() + (m_packed ? m_packed->bytesResident() : 0);
+           intensities().size_bytes() + m_blockCodes.size() * sizeof(morton::Code) +
+           (m_packed ? m_packed->bytesResident() : 0);
 }
 
 void SortedCloud::copyRange(std::size_t begin, std::size_t end, PointBatch& out) const {

@@ -11,6 +11,9 @@
 // read [0, sortedEnd()) without locks: that part never changes again. This is the hand-off
 // between the sorting stage and the hierarchy builder (pipelines 1 and 2 of the paper).
 //
+// A Morton-ordered cloud also keeps the code of every 64th point (block_codes.hpp), written by
+// publish(): cutting the stream into leaves reads it instead of most positions.
+//
 // Positions and colours live in one of two stores (PointStorage): Exact keeps the floats and
 // bytes as read; Packed quantises positions to the level-21 grid and bit-packs both
 // (PackedPointStore: less than half the bytes, every point keeps its code). Read them through
@@ -18,6 +21,7 @@
 // exact arrays only.
 #pragma once
 
+#include "block_codes.hpp"
 #include "cube_transform.hpp"
 #include "huge_page_buffer.hpp"
 #include "morton.hpp"
@@ -94,6 +98,10 @@ public:
         }
         return f(ExactPositions{m_positions.data()});
     }
+    // The block codes of points [0, end), end <= a loaded sortedEnd() (empty for NodeOrder).
+    BlockCodes blockCodes(std::size_t end) const {
+        return BlockCodes(m_blockCodes.data(), m_blockCodes.size() == 0 ? 0 : blockCodeCount(end));
+    }
     // The exact store's arrays (empty for a packed cloud).
     std::span<const glm::vec3> positions() const { return m_positions; }
     std::span<const glm::u8vec3> colors() const { return m_colors; }
@@ -138,6 +146,7 @@ private:
     HugePageArray<glm::vec3> m_normals;
     HugePageArray<glm::u8vec3> m_colors;
     HugePageArray<std::uint16_t> m_intensities;
+    HugePageArray<morton::Code> m_blockCodes;    // CloudOrder::Morton only
     std::unique_ptr<PackedPointStore> m_packed; // Packed storage only
     std::vector<glm::vec3> m_stagedPositions;   // Packed: the range stage() handed out
     std::vector<glm::u8vec3> m_stagedColors;

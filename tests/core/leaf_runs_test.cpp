@@ -5,6 +5,7 @@
 #include <glm/vec3.hpp>
 #include <gtest/gtest.h>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace omicron {
@@ -75,6 +76,24 @@ std::vector<LeafRun> referenceRuns(const std::vector<morton::Code>& codes, std::
     return runs;
 }
 
+// The block codes of `codes` (block_codes.hpp): every 64th code.
+std::vector<morton::Code> blockCodesOf(const std::vector<morton::Code>& codes) {
+    std::vector<morton::Code> index;
+    for (std::size_t i = 0; i < codes.size(); i += kBlockCodePoints) {
+        index.push_back(codes[i]);
+    }
+    return index;
+}
+
+// The indexes a scan of [0, end) may get: none, exactly the entries of [0, end) (what the
+// builder passes while input grows), and the whole cloud's.
+std::vector<std::pair<std::string, BlockCodes>> indexesFor(const std::vector<morton::Code>& index,
+                                                           std::size_t end) {
+    return {{"no index", {}},
+            {"index of [0, end)", BlockCodes(index).first(blockCodeCount(end))},
+            {"whole index", BlockCodes(index)}};
+}
+
 void expectSameRuns(const std::vector<LeafRun>& found, const std::vector<LeafRun>& expected) {
     ASSERT_EQ(found.size(), expected.size());
     for (std::size_t r = 0; r < found.size(); ++r) {
@@ -100,12 +119,16 @@ TEST(LeafRuns, FindLeafRunsMatchesAPlainScanAcrossParallelBlocks) {
     const int level = 6;
     const auto codes = codesWithRuns(lengths, level);
     const auto positions = toPositions(codes);
+    const auto index = blockCodesOf(codes);
     for (const auto& [begin, end] : std::vector<std::pair<std::size_t, std::size_t>>{
              {0, codes.size()}, {1, codes.size() - 1}, {2500, 2600}, {2600, codes.size() - 5}}) {
-        std::vector<LeafRun> runs;
-        findLeafRuns(positions, begin, end, level, runs);
-        SCOPED_TRACE("range " + std::to_string(begin) + ".." + std::to_string(end));
-        expectSameRuns(runs, referenceRuns(codes, begin, end, level));
+        for (const auto& [name, blockCodes] : indexesFor(index, end)) {
+            std::vector<LeafRun> runs;
+            findLeafRuns(positions, blockCodes, begin, end, level, runs);
+            SCOPED_TRACE("range " + std::to_string(begin) + ".." + std::to_string(end) + ", " +
+                         name);
+            expectSameRuns(runs, referenceRuns(codes, begin, end, level));
+        }
     }
 }
 
@@ -118,11 +141,18 @@ TEST(LeafRuns, FindLeafRunsOnRandomCodesAtEveryDepth) {
     codes.back() = ~morton::Code{0}; // the far corner: every coordinate bit set
     std::sort(codes.begin(), codes.end());
     const auto positions = toPositions(codes);
+    const auto index = blockCodesOf(codes);
     for (const int level : {1, 4, 7, 12, 21}) {
-        std::vector<LeafRun> runs;
-        findLeafRuns(positions, 0, positions.size(), level, runs);
-        SCOPED_TRACE("level " + std::to_string(level));
-        expectSameRuns(runs, referenceRuns(codes, 0, codes.size(), level));
+        for (const std::size_t begin : {std::size_t{0}, std::size_t{1000}}) {
+            const std::size_t end = codes.size() - begin;
+            for (const auto& [name, blockCodes] : indexesFor(index, end)) {
+                std::vector<LeafRun> runs;
+                findLeafRuns(positions, blockCodes, begin, end, level, runs);
+                SCOPED_TRACE("level " + std::to_string(level) + ", from " +
+                             std::to_string(begin) + ", " + name);
+                expectSameRuns(runs, referenceRuns(codes, begin, end, level));
+            }
+        }
     }
 }
 
@@ -131,7 +161,7 @@ TEST(LeafRuns, FindLeafRunsCoversTheRangeWithOneRunPerCell) {
     const int level = 4;
     const auto codes = codesWithRuns(lengths, level);
     std::vector<LeafRun> runs;
-    findLeafRuns(toPositions(codes), 0, codes.size(), level, runs);
+    findLeafRuns(toPositions(codes), blockCodesOf(codes), 0, codes.size(), level, runs);
     ASSERT_EQ(runs.size(), lengths.size());
     std::uint32_t begin = 0;
     for (std::size_t r = 0; r < runs.size(); ++r) {
