@@ -5,22 +5,40 @@
 // looking at (std::vector moves its elements, std::deque reallocates its map). The arena does
 // no synchronisation of its own: the writer publishes a count with a release store (see
 // Hierarchy), and a reader only indexes below a count it loaded with acquire.
+//
+// Chunks are allocated uninitialised: every element is written whole before it is published,
+// so zeroing a chunk first would only double the writes, on the writer's thread, where the
+// elements themselves may be written by many (extend()/slot()). Elements are therefore plain
+// data (trivially copyable and destructible: implicitly created by the allocation).
 #pragma once
 
 #include <cassert>
 #include <cstddef>
 #include <memory>
+#include <new>
+#include <type_traits>
 
 namespace omicron {
 
 template <typename T, std::size_t ChunkElements> class ChunkedArena {
     static_assert(ChunkElements > 0 && (ChunkElements & (ChunkElements - 1)) == 0,
                   "chunk size must be a power of two (index split by shift and mask)");
+    static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>,
+                  "elements live in uninitialised chunks");
+
+    struct ChunkDeleter {
+        void operator()(T* chunk) const { ::operator delete(chunk, std::align_val_t{alignof(T)}); }
+    };
+    using Chunk = std::unique_ptr<T, ChunkDeleter>;
+    static Chunk allocateChunk() {
+        return Chunk(static_cast<T*>(
+            ::operator new(ChunkElements * sizeof(T), std::align_val_t{alignof(T)})));
+    }
 
 public:
     explicit ChunkedArena(std::size_t capacity)
-        : m_capacity(capacity), m_chunks(std::make_unique<std::unique_ptr<T[]>[]>(
-                                    (capacity + ChunkElements - 1) / ChunkElements)) {}
+        : m_capacity(capacity),
+          m_chunks(std::make_unique<Chunk[]>((capacity + ChunkElements - 1) / ChunkElements)) {}
 
     ChunkedArena(const ChunkedArena&) = delete;
     ChunkedArena& operator=(const ChunkedArena&) = delete;
@@ -34,22 +52,23 @@ public:
         assert(m_size < m_capacity);
         const std::size_t chunk = m_size / ChunkElements;
         if (m_size % ChunkElements == 0) {
-            m_chunks[chunk] = std::make_unique<T[]>(ChunkElements);
+            m_chunks[chunk] = allocateChunk();
             ++m_chunksAllocated;
         }
-        m_chunks[chunk][m_size % ChunkElements] = value;
+        m_chunks[chunk].get()[m_size % ChunkElements] = value;
         return m_size++;
     }
 
-    // Writer only: appends `count` default elements (allocating their chunks) and returns the
-    // first one's index. The writer may have them filled through slot() by other threads,
-    // provided the filling happens-before the count that covers them is published.
+    // Writer only: appends `count` elements, not yet written (allocating their chunks), and
+    // returns the first one's index. The writer may have them filled whole through slot() by
+    // other threads, provided the filling happens-before the count that covers them is
+    // published.
     std::size_t extend(std::size_t count) {
         assert(count <= m_capacity - m_size);
         const std::size_t first = m_size;
         for (std::size_t chunk = (first + ChunkElements - 1) / ChunkElements;
              chunk * ChunkElements < first + count; ++chunk) {
-            m_chunks[chunk] = std::make_unique<T[]>(ChunkElements);
+            m_chunks[chunk] = allocateChunk();
             ++m_chunksAllocated;
         }
         m_size += count;
@@ -58,23 +77,23 @@ public:
     // An element appended but not yet published, to fill.
     T& slot(std::size_t index) {
         assert(index < m_size);
-        return m_chunks[index / ChunkElements][index % ChunkElements];
+        return m_chunks[index / ChunkElements].get()[index % ChunkElements];
     }
 
     const T& operator[](std::size_t index) const {
-        return m_chunks[index / ChunkElements][index % ChunkElements];
+        return m_chunks[index / ChunkElements].get()[index % ChunkElements];
     }
 
     std::size_t bytesAllocated() const {
         return m_chunksAllocated * ChunkElements * sizeof(T) +
-               (m_capacity + ChunkElements - 1) / ChunkElements * sizeof(std::unique_ptr<T[]>);
+               (m_capacity + ChunkElements - 1) / ChunkElements * sizeof(Chunk);
     }
 
 private:
     std::size_t m_capacity;
     std::size_t m_size = 0;
     std::size_t m_chunksAllocated = 0;
-    std::unique_ptr<std::unique_ptr<T[]>[]> m_chunks;
+    std::unique_ptr<Chunk[]> m_chunks;
 };
 
 } // namespace omicron

@@ -127,8 +127,9 @@ public:
     // Appends a complete node to `level` (Morton order). Not visible before publishNodes().
     std::size_t appendNode(int level, const OctreeNode& node);
     std::size_t builtNodeCount(int level) const { return m_levels[level]->nodes.size(); }
-    // Appends `count` blank nodes to `level` and returns the first one's index; they are filled
-    // through builtNode() (by any thread, in Morton order of index, before publishNodes()).
+    // Appends `count` unwritten nodes to `level` and returns the first one's index; each is
+    // assigned whole through builtNode() (by any thread, in Morton order of index, before
+    // publishNodes()).
     std::size_t extendNodes(int level, std::size_t count) {
         return m_levels[level]->nodes.extend(count);
     }
@@ -136,13 +137,13 @@ public:
         return m_levels[level]->nodes.slot(index);
     }
     // Keeps a buffer of samples a worker filled (no copy); returns where its elements now live.
-    const std::uint32_t* adoptSamples(std::vector<std::uint32_t>&& samples) {
+    const std::uint32_t* adoptSamples(SampleBuffer&& samples) {
         return m_samples.adopt(std::move(samples));
     }
     StoredSplats& mutableStoredSplats() { return *m_storedSplats; } // SplatSource::Stored only
 
     void publishNodes(int level);
-    // Appends `count` blank entries to the insertion log (span order), filled through
+    // Appends `count` unwritten entries to the insertion log (span order), assigned through
     // builtInsertion() as extendNodes() says; not visible before publishInsertions().
     std::size_t extendInsertions(std::size_t count) { return m_insertions.entries.extend(count); }
     CutInsertion& builtInsertion(std::size_t index) { return m_insertions.entries.slot(index); }

@@ -39,8 +39,9 @@ struct ParentDraft {
 struct WorklistResult {
     std::vector<ParentDraft> drafts;
     // The drafts' samples. The commit hands the whole buffer to the hierarchy (no copy on
-    // the master thread), so the worker trims it to size first.
-    std::vector<std::uint32_t> samples;
+    // the master thread); the worker reserves it once, for at most a few entries more than
+    // it fills (see samplesBound), so it neither grows nor is trimmed by a copy.
+    SampleBuffer samples;
     bool ownsSplitGroup = false; // its last group continued into the next worklist
     void clear() {
         drafts.clear();
@@ -48,6 +49,18 @@ struct WorklistResult {
         ownsSplitGroup = false;
     }
 };
+
+// At least the samples the groups of `roots` take: sampleSize(n) <= ratio * n + 1 per group,
+// and there are no more groups than roots. Over by about one entry a group.
+std::size_t samplesBound(const Hierarchy& hierarchy, const ObliqueCut& cut, double ratio,
+                         int level, std::span<const CutRoot> roots) {
+    std::uint64_t points = 0;
+    for (const CutRoot& root : roots) {
+        points += root.placeholder ? cut.placeholder(root.index).coveredCount
+                                   : hierarchy.node(level, root.index).pointCount;
+    }
+    return static_cast<std::size_t>(ratio * static_cast<double>(points)) + roots.size() + 1;
+}
 
 // The parent (or substituted leaf, or risen placeholder) replacing `group` of level
 // parentLevel + 1. Reads only published-or-appended nodes and the cut: safe in parallel.
@@ -325,12 +338,13 @@ void HierarchyBuilder::insertInput(std::size_t available, bool inputEnded) {
         const LeafRun& run = runs[i];
         const CutRoot& root = roots[i];
         if (!root.placeholder) {
-            OctreeNode& leaf = m_hierarchy->builtNode(maxLevel, root.index);
+            OctreeNode leaf; // written whole: the slot is uninitialised memory
             leaf.code = run.code;
             leaf.coveredBegin = run.begin;
             leaf.coveredCount = run.count;
             leaf.pointCount = run.count;
             leaf.flags = static_cast<std::uint8_t>(NodeFlag::Leaf);
+            m_hierarchy->builtNode(maxLevel, root.index) = leaf;
         }
         m_hierarchy->builtInsertion(firstInsertion + i) = {
             root.placeholder ? run.code >> 3 : run.code, run.begin, run.count, publishedAt};
@@ -398,10 +412,14 @@ void HierarchyBuilder::fixLevel(int level) {
                 ++last;
             }
         }
-        forEachSiblingGroup(pending.subspan(first, last - first), [&](std::span<const CutRoot> group) {
+        const std::span<const CutRoot> owned = pending.subspan(first, last - first);
+        const std::size_t bound = samplesBound(*m_hierarchy, m_cut, m_options.ratio, level, owned);
+        result.samples.reserve(bound);
+        forEachSiblingGroup(owned, [&](std::span<const CutRoot> group) {
             draftParent(*m_hierarchy, m_cut, m_options, level - 1, group, result);
         });
-        result.samples.shrink_to_fit();
+        assert(result.samples.size() <= bound); // so the buffer never grew
+        (void)bound;
     };
     if (worklists == 1) {
         runWorklist(0);

@@ -8,14 +8,36 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <new>
+#include <utility>
 #include <vector>
 
 namespace omicron {
 
+// An allocator whose resize() leaves new elements uninitialised: a sample buffer is written
+// right after it grows, so zeroing it first would only double the writes.
+template <typename T> struct UninitializedAllocator : std::allocator<T> {
+    template <typename U> struct rebind {
+        using other = UninitializedAllocator<U>;
+    };
+    UninitializedAllocator() = default;
+    template <typename U> UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
+    template <typename U, typename... Args> void construct(U* p, Args&&... args) {
+        if constexpr (sizeof...(Args) == 0) {
+            ::new (static_cast<void*>(p)) U; // default-initialised: left as it is
+        } else {
+            ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+        }
+    }
+};
+
+using SampleBuffer = std::vector<std::uint32_t, UninitializedAllocator<std::uint32_t>>;
+
 class SampleStore {
 public:
     // One writer thread. Keeps `samples`; returns where its elements live now.
-    const std::uint32_t* adopt(std::vector<std::uint32_t>&& samples) {
+    const std::uint32_t* adopt(SampleBuffer&& samples) {
         m_bytesAllocated += samples.capacity() * sizeof(std::uint32_t);
         m_adopted.push_back(std::move(samples));
         return m_adopted.back().data();
@@ -24,7 +46,7 @@ public:
     std::size_t bytesAllocated() const { return m_bytesAllocated; }
 
 private:
-    std::vector<std::vector<std::uint32_t>> m_adopted;
+    std::vector<SampleBuffer> m_adopted;
     std::size_t m_bytesAllocated = 0;
 };
 

@@ -39,7 +39,7 @@ class TestFactory : public ParentFactory {
 public:
     TestFactory(Hierarchy& hierarchy, double ratio) : m_hierarchy(hierarchy), m_ratio(ratio) {}
 
-    std::function<void(OctreeNode&, std::vector<std::uint32_t>&)> corrupt;
+    std::function<void(OctreeNode&, SampleBuffer&)> corrupt;
 
     CutRoot makeParent(int parentLevel, std::span<const CutRoot> siblings) override {
         std::vector<const OctreeNode*> children;
@@ -55,7 +55,7 @@ public:
         }
         parent.coveredBegin = children.front()->coveredBegin;
         parent.pointCount = sampleSize(childPoints, m_ratio);
-        std::vector<std::uint32_t> samples(parent.pointCount);
+        SampleBuffer samples(parent.pointCount);
         sampleChildren(children, samples);
         if (corrupt) {
             corrupt(parent, samples);
@@ -139,7 +139,7 @@ TEST(CutInvariants, DroppedRootsAreReported) {
 
 struct Corruption {
     const char* name;
-    std::function<void(OctreeNode&, std::vector<std::uint32_t>&)> corrupt;
+    std::function<void(OctreeNode&, SampleBuffer&)> corrupt;
     const char* expected;
     double ratio = 1.0;
 };
@@ -147,7 +147,7 @@ struct Corruption {
 TEST(CutInvariants, CorruptParentsAreReported) {
     const Corruption cases[] = {
         {"duplicate sample",
-         [](OctreeNode&, std::vector<std::uint32_t>& s) {
+         [](OctreeNode&, SampleBuffer& s) {
              if (s.size() == 2) {
                  s[1] = s[0];
              }
@@ -156,29 +156,29 @@ TEST(CutInvariants, CorruptParentsAreReported) {
         // Ratio 0.5: the level-1 parent of points 0 and 1 keeps only point 1, so the root's
         // sample [1, 3] must not take point 0.
         {"sample from elsewhere",
-         [](OctreeNode& n, std::vector<std::uint32_t>& s) {
+         [](OctreeNode& n, SampleBuffer& s) {
              if (n.code == morton::kRoot) {
                  s.front() = 0;
              }
          },
          "sample 0 is not a point of its children", 0.5},
         {"wrong sample size",
-         [](OctreeNode& n, std::vector<std::uint32_t>& s) {
+         [](OctreeNode& n, SampleBuffer& s) {
              s.push_back(s.back());
              n.pointCount = static_cast<std::uint32_t>(s.size());
          },
          "was expected"},
         {"child lost by a merge",
-         [](OctreeNode& n, std::vector<std::uint32_t>&) {
+         [](OctreeNode& n, SampleBuffer&) {
              if (n.childCount == 2) {
                  n.childCount = 1;
              }
          },
          "its children cover"},
-        {"splat scale", [](OctreeNode& n, std::vector<std::uint32_t>&) { n.splatScale *= 2.0f; },
+        {"splat scale", [](OctreeNode& n, SampleBuffer&) { n.splatScale *= 2.0f; },
          "splat scale"},
         {"flagged collapsed",
-         [](OctreeNode& n, std::vector<std::uint32_t>&) {
+         [](OctreeNode& n, SampleBuffer&) {
              n.flags = static_cast<std::uint8_t>(NodeFlag::Collapsed);
          },
          "flagged collapsed but has children"},
