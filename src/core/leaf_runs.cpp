@@ -67,21 +67,12 @@ void appendRunStarts(const Positions& positions, BlockCodes index, std::size_t f
         current = UnitCellBox::of(positions[i - 1], level);
         cell = codeAt(positions[i - 1], level);
     }
-    // Blocks where the cell changes (by the index), to prefetch: those the loop reaches first
-    // now, then each one kPrefetchBlocks ahead of the loop.
-    const auto prefetchIfChanging = [&](std::size_t block) {
-        if (block + 1 < index.size() && (index[block] >> shift) != (index[block + 1] >> shift)) {
-            positions.prefetch(block * kBlockCodePoints, kBlockCodePoints);
-        }
-    };
-    for (std::size_t block = i / kBlockCodePoints;
-         block < i / kBlockCodePoints + kPrefetchBlocks && block * kBlockCodePoints < end;
-         ++block) {
-        prefetchIfChanging(block);
-    }
     while (i < end) {
         const std::size_t block = i / kBlockCodePoints;
-        prefetchIfChanging(block + kPrefetchBlocks);
+        const std::size_t ahead = block + kPrefetchBlocks;
+        if (ahead + 1 < index.size() && (index[ahead] >> shift) != (index[ahead + 1] >> shift)) {
+            positions.prefetch(ahead * kBlockCodePoints, kBlockCodePoints);
+        }
         const std::size_t next = (block + 1) * kBlockCodePoints;
         if (indexedCell(block + 1) == cell) {
             i = next; // [i, next] is in the current cell
