@@ -28,7 +28,7 @@ struct ExactPositions {
 struct PackedPositions {
     const PackedPointStore* store;
     glm::vec3 operator[](std::size_t i) const { return store->position(i); }
-    void prefetch(std::size_t, std::size_t) const {}
+    void prefetch(std::size_t first, std::size_t count) const { store->prefetch(first, count); }
 };
 
 template <typename T>
