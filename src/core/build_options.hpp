@@ -18,10 +18,11 @@ enum class LeafCollapse {
 
 const char* toString(LeafCollapse collapse);
 
-// Measured on autzen_south (4.84M points, depth 7, in-memory sorted stream, 2 cores): the
-// creation time is the same within noise for 8..128 (44-48 ms; the splat estimates dominate,
-// not task overhead), while 8 runs 4x the work items and duplicate-parent merges of 32
-// (6130 / 2663 against 1548 / 665). 32 is also inside the paper's best front range (32-64).
+// Measured on autzen_south (4.84M points, depth 7, in-memory sorted stream, 2 cores, two
+// runs): 8 / 16 / 32 / 64 / 128 -> 5.4-4.5 / 4.4-4.5 / 4.0-3.8 / 4.3-3.4 / 3.9-3.6 ms, with
+// 3400 / 1706 / 859 / 438 / 226 work items and 2663 / 1319 / 665 / 329 / 161 sibling groups
+// split by a worklist boundary. From 32 up the differences are within this machine's noise;
+// 32 is also inside the paper's best front range (32-64).
 inline constexpr std::size_t kDefaultWorklistSize = 32;
 
 // The debug preset (OMICRON_CHECK_INVARIANTS) checks the cut after every fix pass by default.
