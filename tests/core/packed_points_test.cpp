@@ -161,6 +161,14 @@ TEST(PackedPointStore, SortedCloudStagesAndPublishesThroughEitherStore) {
                 staged.intensities[i - begin] = static_cast<std::uint16_t>(i);
             }
             cloud.publish(end);
+            // The block codes (block_codes.hpp) cover the published prefix, a short last block
+            // included, and each is the code of its block's first point.
+            const BlockCodes index = cloud.blockCodes(end);
+            ASSERT_EQ(index.size(), (end + kBlockCodePoints - 1) / kBlockCodePoints);
+            for (std::size_t block = 0; block < index.size(); ++block) {
+                const glm::vec3& p = positions[block * kBlockCodePoints];
+                ASSERT_EQ(index[block], morton::encodeUnit(p.x, p.y, p.z)) << block;
+            }
         }
         cloud.markComplete();
         PointBatch copy;
