@@ -327,10 +327,22 @@ void HierarchyBuilder::insertInput(std::size_t available, bool inputEnded) {
     m_stats.placeholdersCreated += runs.size() - leaves;
     m_stats.collapsedLeaves += runs.size() - leaves;
 
-    // The leaves and the render front's hand-off (front.hpp): one insertion entry per run, in
-    // the same span order, naming the leaf itself (a collapsed leaf is not a node yet). Written
-    // in parallel (fresh memory: the writes and their page faults are the cost), published
-    // leaves first, so that an entry's maxLevel leaf is always published when the entry is.
+    publishLeaves(runs, roots, leaves);
+    m_cut.concatenate(roots);
+    m_insertedEnd = end;
+    m_stats.inputPoints = end;
+    recordMilestones(m_stats.milestonesSeconds, end, m_cloud->capacity(), secondsSinceStart());
+}
+
+// The leaves and the render front's hand-off (front.hpp): one insertion entry per run, in the
+// same span order, naming the leaf itself (a collapsed leaf is not a node yet). Written in
+// parallel into slots the arenas hand out (new cache lines, in a first build new pages too:
+// the writes are the cost), then published, leaves first, so that an entry's maxLevel leaf is
+// always published when the entry is. The entries' publication time is taken before the
+// writes: a front's measured insertion delay may only err long.
+void HierarchyBuilder::publishLeaves(std::span<const LeafRun> runs, std::span<const CutRoot> roots,
+                                     std::size_t leaves) {
+    const int maxLevel = m_options.maxLevel;
     m_hierarchy->extendNodes(maxLevel, leaves);
     const std::size_t firstInsertion = m_hierarchy->extendInsertions(runs.size());
     const auto publishedAt = std::chrono::steady_clock::now();
@@ -357,10 +369,6 @@ void HierarchyBuilder::insertInput(std::size_t available, bool inputEnded) {
                       });
     m_hierarchy->publishNodes(maxLevel);
     m_hierarchy->publishInsertions();
-    m_cut.concatenate(roots);
-    m_insertedEnd = end;
-    m_stats.inputPoints = end;
-    recordMilestones(m_stats.milestonesSeconds, end, m_cloud->capacity(), secondsSinceStart());
 }
 
 // One fix pass from maxLevel up; false when it stopped early (new input, or cancel).

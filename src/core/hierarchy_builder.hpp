@@ -29,6 +29,7 @@
 #include "build_options.hpp"
 #include "build_statistics.hpp"
 #include "hierarchy.hpp"
+#include "leaf_runs.hpp"
 #include "morton_sorter.hpp"
 #include "oblique_cut.hpp"
 
@@ -80,6 +81,8 @@ private:
     void buildLoop();
     bool waitForWork(bool passComplete, std::size_t& available, bool& inputEnded);
     void insertInput(std::size_t available, bool inputEnded);
+    void publishLeaves(std::span<const LeafRun> runs, std::span<const CutRoot> roots,
+                       std::size_t leaves);
     bool fixPass();
     void fixLevel(int level);
     bool shouldStartNewPass(int nextLevel) const;
