@@ -56,6 +56,19 @@ BuildResult buildBest(const std::shared_ptr<const omicron::SortedCloud>& cloud,
     return best;
 }
 
+// The file read and sorted into a SortedCloud of the given point store.
+std::shared_ptr<const omicron::SortedCloud> sortFile(const std::string& path,
+                                                     omicron::PointStorage storage) {
+    std::shared_ptr<const omicron::SortedCloud> cloud;
+    auto reader = omicron::openPointCloud(path);
+    omicron::SortOptions sortOptions;
+    sortOptions.storage = storage;
+    omicron::sortPointCloud(
+        *reader, sortOptions, [](const omicron::SortedCloud&, std::size_t, std::size_t) {},
+        [&](const omicron::IncrementalMortonSorter& sorter) { cloud = sorter.cloud(); });
+    return cloud;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -70,13 +83,7 @@ int main(int argc, char** argv) {
     }
     try {
         const double fileBytes = static_cast<double>(std::filesystem::file_size(path));
-        std::shared_ptr<const omicron::SortedCloud> cloud;
-        {
-            auto reader = omicron::openPointCloud(path);
-            omicron::sortPointCloud(
-                *reader, {}, [](const omicron::SortedCloud&, std::size_t, std::size_t) {},
-                [&](const omicron::IncrementalMortonSorter& sorter) { cloud = sorter.cloud(); });
-        }
+        const auto cloud = sortFile(path, omicron::PointStorage::Exact);
         const std::size_t points = cloud->sortedEnd();
 
         // (a) baselines: parse the same file (bounds known), one memcpy of the points.
@@ -144,16 +151,7 @@ int main(int argc, char** argv) {
 
         // (c) leaf collapse x ratio, for either point store (the packed cloud sorted from the
         // same file: same order, same leaves, positions on the level-21 grid).
-        std::shared_ptr<const omicron::SortedCloud> packed;
-        {
-            auto reader = omicron::openPointCloud(path);
-            omicron::SortOptions sortOptions;
-            sortOptions.storage = omicron::PointStorage::Packed;
-            omicron::sortPointCloud(
-                *reader, sortOptions,
-                [](const omicron::SortedCloud&, std::size_t, std::size_t) {},
-                [&](const omicron::IncrementalMortonSorter& sorter) { packed = sorter.cloud(); });
-        }
+        const auto packed = sortFile(path, omicron::PointStorage::Packed);
         for (const auto& [storeCloud, store] :
              {std::pair{cloud, omicron::PointStorage::Exact},
               std::pair{packed, omicron::PointStorage::Packed}})

@@ -49,14 +49,9 @@ public:
 
     // Writer only. Returns the new element's index.
     std::size_t push_back(const T& value) {
-        assert(m_size < m_capacity);
-        const std::size_t chunk = m_size / ChunkElements;
-        if (m_size % ChunkElements == 0) {
-            m_chunks[chunk] = allocateChunk();
-            ++m_chunksAllocated;
-        }
-        m_chunks[chunk].get()[m_size % ChunkElements] = value;
-        return m_size++;
+        const std::size_t index = extend(1);
+        slot(index) = value;
+        return index;
     }
 
     // Writer only: appends `count` elements, not yet written (allocating their chunks), and
@@ -69,7 +64,6 @@ public:
         for (std::size_t chunk = (first + ChunkElements - 1) / ChunkElements;
              chunk * ChunkElements < first + count; ++chunk) {
             m_chunks[chunk] = allocateChunk();
-            ++m_chunksAllocated;
         }
         m_size += count;
         return first;
@@ -85,14 +79,14 @@ public:
     }
 
     std::size_t bytesAllocated() const {
-        return m_chunksAllocated * ChunkElements * sizeof(T) +
+        // Chunks exist exactly for the elements appended.
+        return (m_size + ChunkElements - 1) / ChunkElements * ChunkElements * sizeof(T) +
                (m_capacity + ChunkElements - 1) / ChunkElements * sizeof(Chunk);
     }
 
 private:
     std::size_t m_capacity;
     std::size_t m_size = 0;
-    std::size_t m_chunksAllocated = 0;
     std::unique_ptr<Chunk[]> m_chunks;
 };
 

@@ -28,12 +28,10 @@ constexpr std::size_t kLeafFillGrain = 256;
 struct ParentDraft {
     OctreeNode node; // sampleIndices not set: the sample is in the owning result
     std::uint32_t sampleOffset = 0;
-    bool sampled = false;           // node holds a sample (copied at commit)
+    bool sampled = false;           // node holds a sample (its pointer set at commit)
     bool substituted = false;       // a placeholder became its leaf here
     bool risingPlaceholder = false; // no node: the placeholder moves up as `root`
     CutRoot root;
-
-    morton::Code code() const { return risingPlaceholder ? root.code : node.code; }
 };
 
 struct WorklistResult {
@@ -427,7 +425,6 @@ void HierarchyBuilder::fixLevel(int level) {
             draftParent(*m_hierarchy, m_cut, m_options, level - 1, group, result);
         });
         assert(result.samples.size() <= bound); // so the buffer never grew
-        (void)bound;
     };
     if (worklists == 1) {
         runWorklist(0);

@@ -3,8 +3,8 @@
 #include "unit_cell_box.hpp"
 
 #include <algorithm>
-#include <optional>
 #include <cassert>
+#include <optional>
 #include <tbb/parallel_for.h>
 
 namespace omicron {
@@ -33,8 +33,9 @@ std::size_t partitionPoint(const Positions& positions, std::size_t low, std::siz
     return low;
 }
 
-// Appends to `starts` (and their cells' codes at `level` to `codes`) every index i in
-// [begin, end) where a run starts: i == first, or the cell of i differs from the cell of i - 1.
+// Appends to `runs` a run (its code at `level` and first index; its count is left to the caller)
+// for every index i in [begin, end) where one starts: i == first, or the cell of i differs from
+// the cell of i - 1.
 // A block of the index whose next entry is still in the current cell holds no start and is
 // skipped unread; in the others, each start is found by binary search (the points in the
 // current cell come first). Those blocks are prefetched whole a few dozen blocks ahead, as the
@@ -43,8 +44,7 @@ std::size_t partitionPoint(const Positions& positions, std::size_t low, std::siz
 // 2.4-3.0 / 1.4-1.9 ms.
 template <typename Positions>
 void appendRunStarts(const Positions& positions, BlockCodes index, std::size_t first,
-                     std::size_t begin, std::size_t end, int level,
-                     std::vector<std::uint32_t>& starts, std::vector<morton::Code>& codes) {
+                     std::size_t begin, std::size_t end, int level, std::vector<LeafRun>& runs) {
     constexpr std::size_t kPrefetchBlocks = 32;
     const int shift = 3 * (morton::kMaxLevel - level);
     // The index's cell for block k's first point; none past the index's end.
@@ -55,10 +55,9 @@ void appendRunStarts(const Positions& positions, BlockCodes index, std::size_t f
     UnitCellBox current{};
     morton::Code cell = 0;
     const auto startRun = [&](std::size_t at) {
-        starts.push_back(static_cast<std::uint32_t>(at));
         current = UnitCellBox::of(positions[at], level);
         cell = codeAt(positions[at], level);
-        codes.push_back(cell);
+        runs.push_back({cell, static_cast<std::uint32_t>(at), 0});
     };
     if (begin == first) {
         startRun(begin);
@@ -131,38 +130,26 @@ void findLeafRuns(const Positions& positions, BlockCodes index, std::size_t begi
         return;
     }
     const std::size_t blocks = (end - begin + kRunBlockPoints - 1) / kRunBlockPoints;
-    // Each block lists its run starts and their codes on its own (in parallel when there are
-    // several); the lists joined in block order are the runs of the whole range.
-    std::vector<std::vector<std::uint32_t>> starts(blocks);
-    std::vector<std::vector<morton::Code>> codes(blocks);
+    // Each block lists the runs starting in it on its own (in parallel when there are several);
+    // joined in block order, each run ends where the next one starts.
+    std::vector<std::vector<LeafRun>> blockRuns(blocks);
     const auto scanBlock = [&](std::size_t block) {
         const std::size_t blockBegin = begin + block * kRunBlockPoints;
-        std::vector<std::uint32_t> blockStarts; // filled locally: no shared cache lines
-        std::vector<morton::Code> blockCodes;
+        std::vector<LeafRun> found; // filled locally: no shared cache lines
         appendRunStarts(positions, index, begin, blockBegin,
-                        std::min(end, blockBegin + kRunBlockPoints), maxLevel, blockStarts,
-                        blockCodes);
-        starts[block] = std::move(blockStarts);
-        codes[block] = std::move(blockCodes);
+                        std::min(end, blockBegin + kRunBlockPoints), maxLevel, found);
+        blockRuns[block] = std::move(found);
     };
     if (blocks == 1) {
         scanBlock(0);
     } else {
         tbb::parallel_for(std::size_t{0}, blocks, scanBlock);
     }
-    std::size_t total = 0;
-    for (const std::vector<std::uint32_t>& blockStarts : starts) {
-        total += blockStarts.size();
+    const std::size_t first = runs.size();
+    for (const std::vector<LeafRun>& found : blockRuns) {
+        runs.insert(runs.end(), found.begin(), found.end());
     }
-    std::size_t run = runs.size();
-    runs.resize(run + total);
-    for (std::size_t block = 0; block < blocks; ++block) {
-        for (std::size_t i = 0; i < starts[block].size(); ++i, ++run) {
-            runs[run].code = codes[block][i];
-            runs[run].begin = starts[block][i];
-        }
-    }
-    for (std::size_t r = runs.size() - total; r < runs.size(); ++r) {
+    for (std::size_t r = first; r < runs.size(); ++r) {
         const std::size_t runEnd = r + 1 < runs.size() ? runs[r + 1].begin : end;
         runs[r].count = static_cast<std::uint32_t>(runEnd - runs[r].begin);
     }

@@ -53,9 +53,8 @@ public:
 
     glm::vec3 position(std::size_t i) const {
         const Block block = blockOf(i);
-        const std::size_t bit = (i % kBlockPoints) * block.header.recordBits;
         glm::vec3 p;
-        std::size_t offset = bit;
+        std::size_t offset = (i % kBlockPoints) * block.header.recordBits;
         for (int axis = 0; axis < 3; ++axis) {
             const std::uint32_t cell =
                 block.header.base[axis] + field(block.bits, offset, block.header.widths[axis]);
@@ -128,7 +127,8 @@ private:
     static std::uint32_t field(const std::byte* bits, std::size_t offset, int width) {
         std::uint64_t word;
         std::memcpy(&word, bits + offset / 8, sizeof(word));
-        return static_cast<std::uint32_t>((word >> (offset % 8)) & ((std::uint64_t{1} << width) - 1));
+        return static_cast<std::uint32_t>((word >> (offset % 8)) &
+                                          ((std::uint64_t{1} << width) - 1));
     }
 
     static Header headerFor(std::span<const glm::vec3> positions,

@@ -56,8 +56,8 @@ TEST_P(CliBuildSharedData, LevelsMatchABruteForceOctree) {
     const std::string oms = dir.file("sorted.oms");
     ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"sort", path, oms}).exitCode, 0);
     for (const std::string& input : {path, oms}) {
-        const auto result = runProcess(OMICRON_CLI_PATH,
-                                       {"build", input, "--depth", std::to_string(depth), "--json"});
+        const auto result = runProcess(
+            OMICRON_CLI_PATH, {"build", input, "--depth", std::to_string(depth), "--json"});
         ASSERT_EQ(result.exitCode, 0) << result.err;
         EXPECT_NE(result.out.find("\"points_in\":" + std::to_string(cloud.points.size())),
                   std::string::npos)

@@ -77,7 +77,8 @@ TEST(ChunkedArena, ReaderSeesWholeElementsThatWorkersWroteBeforePublication) {
     for (std::size_t first = 0; first < kCapacity;) {
         const std::size_t count = std::min<std::size_t>(kCapacity - first, 1 + first % 5000);
         ASSERT_EQ(arena.extend(count), first);
-        tbb::parallel_for(first, first + count, [&](std::size_t i) { arena.slot(i) = entryFor(i); });
+        tbb::parallel_for(first, first + count,
+                          [&](std::size_t i) { arena.slot(i) = entryFor(i); });
         first += count;
         published.store(first, std::memory_order_release);
     }

@@ -25,12 +25,10 @@ using test::buildSynthetic;
 using test::makeCloud;
 using test::Shape;
 
+// The front tests build with lossless collapse unless they say otherwise: collapsed leaves
+// travel the cut as placeholders, which the front must substitute.
 BuildOptions frontBuildOptions(int maxLevel, LeafCollapse collapse = LeafCollapse::Lossless) {
-    BuildOptions options;
-    options.maxLevel = maxLevel;
-    options.collapse = collapse;
-    options.checkInvariants = true;
-    return options;
+    return test::checkedOptions(maxLevel, collapse);
 }
 
 FrontOptions unlimited(double thresholdPx) {

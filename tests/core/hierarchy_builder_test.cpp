@@ -16,18 +16,11 @@ namespace omicron {
 namespace {
 
 using test::buildSynthetic;
+using test::checkedOptions;
 using test::expectValidBuild;
 using test::fingerprint;
 using test::makeCloud;
 using test::Shape;
-
-BuildOptions checkedOptions(int maxLevel, LeafCollapse collapse = LeafCollapse::Off) {
-    BuildOptions options;
-    options.maxLevel = maxLevel;
-    options.collapse = collapse;
-    options.checkInvariants = true;
-    return options;
-}
 
 TEST(HierarchyBuilder, RejectsOptionsOutOfRange) {
     const auto cloud =

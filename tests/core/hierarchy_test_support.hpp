@@ -114,6 +114,15 @@ inline SyntheticCloud makeCloud(Shape shape, std::size_t count, std::uint64_t se
     return cloud;
 }
 
+// Build options with the cut invariants checked after every fix pass.
+inline BuildOptions checkedOptions(int maxLevel, LeafCollapse collapse = LeafCollapse::Off) {
+    BuildOptions options;
+    options.maxLevel = maxLevel;
+    options.collapse = collapse;
+    options.checkInvariants = true;
+    return options;
+}
+
 struct BuildResult {
     std::shared_ptr<const SortedCloud> cloud;
     std::unique_ptr<HierarchyBuilder> builder;

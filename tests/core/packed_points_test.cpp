@@ -19,6 +19,8 @@
 namespace omicron {
 namespace {
 
+using test::checkedOptions;
+
 glm::vec3 cellCentre(const glm::vec3& p) {
     glm::vec3 centre;
     for (int axis = 0; axis < 3; ++axis) {
@@ -51,9 +53,10 @@ void makeSortedPoints(std::size_t count, std::vector<glm::vec3>& positions,
                              ? glm::u8vec3(100 + i % 7, 50, 200)
                              : glm::u8vec3(random() & 0xff, random() & 0xff, random() & 0xff));
     }
-    std::stable_sort(positions.begin(), positions.end(), [](const glm::vec3& a, const glm::vec3& b) {
-        return morton::encodeUnit(a.x, a.y, a.z) < morton::encodeUnit(b.x, b.y, b.z);
-    });
+    std::stable_sort(
+        positions.begin(), positions.end(), [](const glm::vec3& a, const glm::vec3& b) {
+            return morton::encodeUnit(a.x, a.y, a.z) < morton::encodeUnit(b.x, b.y, b.z);
+        });
 }
 
 TEST(PackedPointStore, PointsDecodeToTheirCellCentresAndColoursExactly) {
@@ -184,14 +187,6 @@ TEST(PackedPointStore, SortedCloudStagesAndPublishesThroughEitherStore) {
     }
 }
 
-BuildOptions checked(int maxLevel, LeafCollapse collapse = LeafCollapse::Off) {
-    BuildOptions options;
-    options.maxLevel = maxLevel;
-    options.collapse = collapse;
-    options.checkInvariants = true;
-    return options;
-}
-
 TEST(PackedCloudBuild, AdversarialCloudsBuildTheSameHierarchyAsExact) {
     using test::Shape;
     for (const auto& [shape, count] : std::vector<std::pair<Shape, std::size_t>>{
@@ -206,8 +201,8 @@ TEST(PackedCloudBuild, AdversarialCloudsBuildTheSameHierarchyAsExact) {
         SCOPED_TRACE(test::toString(shape));
         const auto cloud = test::makeCloud(shape, count, 21);
         for (const LeafCollapse collapse : {LeafCollapse::Off, LeafCollapse::Paper}) {
-            const auto exact = test::buildSynthetic(cloud, checked(6, collapse));
-            const auto packed = test::buildSynthetic(cloud, checked(6, collapse), 1000, 8,
+            const auto exact = test::buildSynthetic(cloud, checkedOptions(6, collapse));
+            const auto packed = test::buildSynthetic(cloud, checkedOptions(6, collapse), 1000, 8,
                                                      PointStorage::Packed);
             test::expectValidBuild(packed);
             EXPECT_EQ(packed.cloud->storage(), PointStorage::Packed);
@@ -221,8 +216,8 @@ TEST(PackedCloudBuild, AdversarialCloudsBuildTheSameHierarchyAsExact) {
 // of their exact bytes (measured 0.55-0.61; normals and intensities are kept as read by either
 // store).
 void expectSameHierarchyInLessMemory(const std::string& path, int maxLevel) {
-    const auto exact = test::buildFile(path, checked(maxLevel));
-    const auto packed = test::buildFile(path, checked(maxLevel), PointStorage::Packed);
+    const auto exact = test::buildFile(path, checkedOptions(maxLevel));
+    const auto packed = test::buildFile(path, checkedOptions(maxLevel), PointStorage::Packed);
     test::expectValidBuild(packed);
     const Hierarchy& hierarchy = packed.builder->hierarchy();
     EXPECT_EQ(test::fingerprint(hierarchy, false),
@@ -245,7 +240,8 @@ void expectSameHierarchyInLessMemory(const std::string& path, int maxLevel) {
     };
     const std::size_t exactBytes = exactStats.cloudBytes - kept(exactCloud);
     const std::size_t packedBytes = packedStats.cloudBytes - kept(packedCloud);
-    testing::Test::RecordProperty("packed_vs_exact", std::to_string(double(packedBytes) / double(exactBytes)));
+    testing::Test::RecordProperty("packed_vs_exact",
+                                  std::to_string(double(packedBytes) / double(exactBytes)));
     EXPECT_LT(packedBytes * 3, exactBytes * 2)
         << "positions and colours: packed " << packedBytes << " vs exact " << exactBytes;
 }
@@ -281,7 +277,7 @@ TEST(PackedCloudSharedData, AutzenSouthResidentBytesUnderSixtyPercentOfTheFile) 
 
 TEST(PackedCloudSharedData, SortedStreamReadsIntoAPackedCloud) {
     OMICRON_REQUIRE_SHARED_FILE(path, "lion.ply");
-    const auto exact = test::buildFile(path, checked(7));
+    const auto exact = test::buildFile(path, checkedOptions(7));
     const std::string oms =
         (std::filesystem::temp_directory_path() / "omicron_packed_lion.oms").string();
     writeOms(oms, *exact.cloud, exact.cloud->sortedEnd());
