@@ -258,18 +258,20 @@ private:
             level + 1 == m_maxLevel && children[0]->isLeaf()) {
             return fail(where() + ": its only child is a leaf that collapse should have merged");
         }
-        if (node.holdsRange() || node.pointCount != sampleSize(childPoints, m_context.ratio)) {
+        if (node.pointCount != sampleSize(childPoints, m_context.ratio)) {
             return fail(where() + " holds " + std::to_string(node.pointCount) +
                         " points; a sample of " +
                         std::to_string(sampleSize(childPoints, m_context.ratio)) + " of " +
                         std::to_string(childPoints) + " was expected");
         }
-        // Samples ascend and are drawn from the children's held points (both lists ascend).
+        // Samples ascend and are drawn from the children's held points (both lists ascend),
+        // stored or implicit alike: an implicit sample whose children do not hold its covered
+        // range would name points they do not hold.
         std::size_t child = 0;
         std::uint32_t held = 0;
         for (std::uint32_t s = 0; s < node.pointCount; ++s) {
-            const std::uint32_t sample = node.sampleIndices[s];
-            if (s > 0 && sample <= node.sampleIndices[s - 1]) {
+            const std::uint32_t sample = node.heldPoint(s);
+            if (s > 0 && sample <= node.heldPoint(s - 1)) {
                 return fail(where() + ": samples not strictly ascending (duplicate?)");
             }
             while (child < children.size() && (held == children[child]->pointCount ||
@@ -309,14 +311,13 @@ private:
             }
             return true;
         }
-        if (node.holdsRange() ||
-            node.pointCount != sampleSize(node.coveredCount, m_context.ratio)) {
+        if (node.pointCount != sampleSize(node.coveredCount, m_context.ratio)) {
             return fail(where() + ": a paper-collapsed leaf must hold a sample of its points");
         }
         for (std::uint32_t s = 0; s < node.pointCount; ++s) {
-            const std::uint32_t sample = node.sampleIndices[s];
+            const std::uint32_t sample = node.heldPoint(s);
             if (sample < node.coveredBegin || sample >= node.coveredBegin + node.coveredCount ||
-                (s > 0 && sample <= node.sampleIndices[s - 1])) {
+                (s > 0 && sample <= node.heldPoint(s - 1))) {
                 return fail(where() + ": its sample is not an ascending subset of its points");
             }
         }

@@ -31,7 +31,7 @@ constexpr std::size_t kLeafFillGrain = 256;
 struct ParentDraft {
     OctreeNode node; // sampleIndices not set: the sample is in the owning result
     std::uint32_t sampleOffset = 0;
-    bool sampled = false;           // node holds a sample (its pointer set at commit)
+    bool sampled = false;           // node stores a sample (its pointer set at commit)
     bool substituted = false;       // a placeholder became its leaf here
     bool risingPlaceholder = false; // no node: the placeholder moves up as `root`
     CutRoot root;
@@ -51,16 +51,45 @@ struct WorklistResult {
     }
 };
 
-// At least the samples the groups of `roots` take: sampleSize(n) <= ratio * n + 1 per group,
-// and there are no more groups than roots. Over by about one entry a group.
-std::size_t samplesBound(const Hierarchy& hierarchy, const ObliqueCut& cut, double ratio,
-                         int level, std::span<const CutRoot> roots) {
+// Whether the parent of these children keeps its sample implicit (OctreeNode::heldPoint): when
+// each holds its whole covered range, together they hold the parent's covered range, and the
+// stratified picks of it are a formula. Most parents of a build are one level above the leaves.
+bool implicitSample(std::span<const OctreeNode* const> children, std::uint64_t covered) {
+    return covered <= kMaxImplicitSampleCovered &&
+           std::all_of(children.begin(), children.end(),
+                       [](const OctreeNode* child) { return child->holdsRange(); });
+}
+
+// At least the sample entries the sibling groups of `roots` store: sampleSize(n) <= ratio * n
+// + 1 for a group whose sample is not implicit. Over by about one entry a stored group.
+std::size_t samplesBound(const Hierarchy& hierarchy, const ObliqueCut& cut, double ratio, int level,
+                         std::span<const CutRoot> roots) {
     std::uint64_t points = 0;
-    for (const CutRoot& root : roots) {
-        points += root.placeholder ? cut.placeholder(root.index).coveredCount
-                                   : hierarchy.node(level, root.index).pointCount;
-    }
-    return static_cast<std::size_t>(ratio * static_cast<double>(points)) + roots.size() + 1;
+    std::size_t groups = 0;
+    forEachSiblingGroup(roots, [&](std::span<const CutRoot> group) {
+        if (group.front().placeholder) {
+            const std::uint64_t covered = cut.placeholder(group.front().index).coveredCount;
+            if (covered > kMaxImplicitSampleCovered) {
+                points += covered;
+                ++groups;
+            }
+            return;
+        }
+        bool stored = false;
+        std::uint64_t groupPoints = 0;
+        std::uint64_t groupCovered = 0;
+        for (const CutRoot& root : group) {
+            const OctreeNode& child = hierarchy.node(level, root.index);
+            stored = stored || !child.holdsRange();
+            groupPoints += child.pointCount;
+            groupCovered += child.coveredCount;
+        }
+        if (stored || groupCovered > kMaxImplicitSampleCovered) {
+            points += groupPoints;
+            ++groups;
+        }
+    });
+    return static_cast<std::size_t>(ratio * static_cast<double>(points)) + groups + 1;
 }
 
 // The parent (or substituted leaf, or risen placeholder) replacing `group` of level
@@ -88,12 +117,15 @@ void draftParent(const Hierarchy& hierarchy, const ObliqueCut& cut, const BuildO
         leaf.pointCount = placeholder.coveredCount;
         draft.substituted = true;
         if (options.collapse == LeafCollapse::Paper) {
+            // The stratified picks of its range: implicit (OctreeNode::heldPoint) unless huge.
             leaf.pointCount = sampleSize(placeholder.coveredCount, options.ratio);
-            draft.sampled = true;
-            draft.sampleOffset = static_cast<std::uint32_t>(out.samples.size());
-            out.samples.resize(out.samples.size() + leaf.pointCount);
-            sampleRange(placeholder.coveredBegin, placeholder.coveredCount,
-                        std::span(out.samples).subspan(draft.sampleOffset));
+            if (placeholder.coveredCount > kMaxImplicitSampleCovered) {
+                draft.sampled = true;
+                draft.sampleOffset = static_cast<std::uint32_t>(out.samples.size());
+                out.samples.resize(out.samples.size() + leaf.pointCount);
+                sampleRange(placeholder.coveredBegin, placeholder.coveredCount,
+                            std::span(out.samples).subspan(draft.sampleOffset));
+            }
         }
         out.drafts.push_back(draft);
         return;
@@ -118,6 +150,11 @@ void draftParent(const Hierarchy& hierarchy, const ObliqueCut& cut, const BuildO
         parent.coveredCount += child->coveredCount;
     }
     parent.pointCount = sampleSize(childPoints, options.ratio);
+    if (implicitSample(children, parent.coveredCount)) {
+        assert(childPoints == parent.coveredCount);
+        out.drafts.push_back(draft);
+        return;
+    }
     draft.sampled = true;
     draft.sampleOffset = static_cast<std::uint32_t>(out.samples.size());
     out.samples.resize(out.samples.size() + parent.pointCount);
@@ -291,8 +328,7 @@ void HierarchyBuilder::insertInput(std::size_t available, bool inputEnded) {
                                               groupLevel, kMaxInsertPoints);
         m_inputBacklog = insertableEnd(positions, cut, available, inputEnded, groupLevel,
                                        kMaxInsertPoints) > cut;
-        findLeafRuns(positions, m_cloud->blockCodes(available), m_insertedEnd, cut, maxLevel,
-                     runs);
+        findLeafRuns(positions, m_cloud->blockCodes(available), m_insertedEnd, cut, maxLevel, runs);
         return cut;
     });
     if (end == m_insertedEnd) {
@@ -464,9 +500,9 @@ void HierarchyBuilder::fixLevel(int level) {
             if (draft.sampled) {
                 node.sampleIndices = samples + draft.sampleOffset;
             }
-            parents.push_back(
-                {node.code, static_cast<std::uint32_t>(m_hierarchy->appendNode(level - 1, node)),
-                 false});
+            parents.push_back({node.code,
+                               static_cast<std::uint32_t>(m_hierarchy->appendNode(level - 1, node)),
+                               false});
             ++parentLevel.nodes;
             parentLevel.points += node.pointCount;
             if (draft.substituted) {

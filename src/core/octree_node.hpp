@@ -3,7 +3,11 @@
 // Points are never copied into nodes. Because the cloud is in Morton order, the input points
 // under any node form one contiguous index range of the SortedCloud (the "covered" range). A
 // leaf holds its whole covered range; a parent (and a leaf dropped to a sample by the paper's
-// leaf collapse) holds a sorted list of SortedCloud indices chosen from its children.
+// leaf collapse) holds the stratified sample of its children's held points (parent_sampler).
+// That sample is stored as a list of indices only where it must be: when every child holds
+// its whole covered range (as above the leaves), the children's held points are the parent's
+// covered range and the sample is a formula of it (implicit); a paper-collapsed leaf's sample
+// is the same formula of its own range.
 #pragma once
 
 #include "morton.hpp"
@@ -11,6 +15,10 @@
 #include <cstdint>
 
 namespace omicron {
+
+// The largest covered range an implicit sample may have: heldPoint's numerator
+// (2i + 1) coveredCount then stays below 2^63. A larger node stores its sample.
+constexpr std::uint64_t kMaxImplicitSampleCovered = std::uint64_t{1} << 31;
 
 enum class NodeFlag : std::uint8_t {
     Leaf = 1u << 0,
@@ -20,8 +28,10 @@ enum class NodeFlag : std::uint8_t {
 
 struct OctreeNode {
     morton::Code code = 0;
-    // nullptr: the node holds SortedCloud indices [coveredBegin, coveredBegin + pointCount).
-    // Otherwise pointCount strictly ascending SortedCloud indices inside the covered range.
+    // The pointCount strictly ascending SortedCloud indices the node holds, inside its covered
+    // range. Or nullptr: the node holds the stratified picks of its covered range, pick i being
+    // coveredBegin + floor((2i + 1) coveredCount / (2 pointCount)): the whole range when
+    // pointCount == coveredCount (a leaf), an implicit sample when it is less.
     const std::uint32_t* sampleIndices = nullptr;
     std::uint32_t coveredBegin = 0; // first SortedCloud index of the subtree's input points
     std::uint32_t coveredCount = 0; // input points in the subtree
@@ -36,11 +46,24 @@ struct OctreeNode {
     int level() const { return morton::level(code); }
     bool has(NodeFlag flag) const { return (flags & static_cast<std::uint8_t>(flag)) != 0; }
     bool isLeaf() const { return has(NodeFlag::Leaf); }
-    bool holdsRange() const { return sampleIndices == nullptr; }
+    // Holds every point it covers: [coveredBegin, coveredBegin + pointCount).
+    bool holdsRange() const { return sampleIndices == nullptr && pointCount == coveredCount; }
+    // Holds the stratified picks of its covered range, computed rather than stored.
+    bool holdsImplicitSample() const {
+        return sampleIndices == nullptr && pointCount != coveredCount;
+    }
 
     // SortedCloud index of the i-th point this node holds (i < pointCount); ascending in i.
     std::uint32_t heldPoint(std::uint32_t i) const {
-        return sampleIndices == nullptr ? coveredBegin + i : sampleIndices[i];
+        if (sampleIndices != nullptr) {
+            return sampleIndices[i];
+        }
+        if (pointCount == coveredCount) {
+            return coveredBegin + i;
+        }
+        const std::uint64_t numerator = (2 * std::uint64_t{i} + 1) * coveredCount;
+        return coveredBegin +
+               static_cast<std::uint32_t>(numerator / (2 * std::uint64_t{pointCount}));
     }
 };
 

@@ -1,6 +1,7 @@
 #include "parent_sampler.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 
@@ -18,6 +19,8 @@ public:
           m_stepQuotient(2 * n / m_divisor), m_stepRemainder(2 * n % m_divisor) {}
 
     std::uint64_t position() const { return m_quotient; }
+    // How far position() moves per pick: this or one more.
+    std::uint64_t step() const { return m_stepQuotient; }
     void next() {
         m_quotient += m_stepQuotient;
         m_remainder += m_stepRemainder;
@@ -35,6 +38,53 @@ private:
     std::uint64_t m_stepRemainder;
 };
 
+// The held points of an implicit-sample child (OctreeNode::heldPoint) at increasing positions
+// k that move by `step` or `step + 1`, as a parent's picks do: floor((2k + 1) n / 2m) is carried
+// as a quotient and remainder, so a pick costs additions, not a division (a level of a build
+// draws most of its samples from such children).
+class ImplicitHeldPoints {
+public:
+    ImplicitHeldPoints(const OctreeNode& node, std::uint64_t k, std::uint64_t step)
+        : m_base(node.coveredBegin), m_divisor(2 * std::uint64_t{node.pointCount}), m_k(k),
+          m_step(step) {
+        assert(node.holdsImplicitSample() && node.coveredCount <= kMaxImplicitSampleCovered);
+        const std::uint64_t n = node.coveredCount;
+        m_quotient = (2 * k + 1) * n / m_divisor;
+        m_remainder = (2 * k + 1) * n % m_divisor;
+        // A step that would leave the node is never taken: should its product wrap (it is
+        // unsigned, so that is defined), the wrapped value is never used.
+        for (std::uint64_t s = 0; s < 2; ++s) {
+            m_stepQuotient[s] = 2 * (step + s) * n / m_divisor;
+            m_stepRemainder[s] = 2 * (step + s) * n % m_divisor;
+        }
+    }
+
+    std::uint32_t at(std::uint64_t k) {
+        if (k != m_k) {
+            const std::uint64_t s = k - m_k - m_step;
+            assert(s < 2);
+            m_k = k;
+            m_quotient += m_stepQuotient[s];
+            m_remainder += m_stepRemainder[s];
+            if (m_remainder >= m_divisor) {
+                m_remainder -= m_divisor;
+                ++m_quotient;
+            }
+        }
+        return m_base + static_cast<std::uint32_t>(m_quotient);
+    }
+
+private:
+    std::uint32_t m_base;
+    std::uint64_t m_divisor;
+    std::uint64_t m_k;
+    std::uint64_t m_step;
+    std::uint64_t m_quotient;
+    std::uint64_t m_remainder;
+    std::array<std::uint64_t, 2> m_stepQuotient{};
+    std::array<std::uint64_t, 2> m_stepRemainder{};
+};
+
 } // namespace
 
 std::uint32_t sampleSize(std::uint64_t childrenPoints, double ratio) {
@@ -50,7 +100,7 @@ void sampleChildren(std::span<const OctreeNode* const> children, std::span<std::
     }
     assert(!out.empty() && out.size() <= n);
     // Each child takes the picks that fall in its part of the list, with one loop per kind of
-    // child (a range or a sample list) so the inner loop is a plain copy.
+    // child (a range, a sample list, an implicit sample) so the inner loops stay plain.
     StratifiedPicks picks(n, out.size());
     std::size_t j = 0;
     std::uint64_t childStart = 0; // position of the child's first point in the list
@@ -62,10 +112,15 @@ void sampleChildren(std::span<const OctreeNode* const> children, std::span<std::
             for (; j < out.size() && picks.position() < childEnd; ++j, picks.next()) {
                 out[j] = static_cast<std::uint32_t>(base + picks.position());
             }
-        } else {
+        } else if (child->sampleIndices != nullptr) {
             const std::uint32_t* samples = child->sampleIndices;
             for (; j < out.size() && picks.position() < childEnd; ++j, picks.next()) {
                 out[j] = samples[picks.position() - childStart];
+            }
+        } else if (j < out.size() && picks.position() < childEnd) {
+            ImplicitHeldPoints held(*child, picks.position() - childStart, picks.step());
+            for (; j < out.size() && picks.position() < childEnd; ++j, picks.next()) {
+                out[j] = held.at(picks.position() - childStart);
             }
         }
         childStart = childEnd;

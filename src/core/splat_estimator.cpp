@@ -206,10 +206,14 @@ void estimateNodeSplats(const SortedCloud& cloud, const OctreeNode& node,
         sumCells(
             cloud, count, fineLevel, origin, [begin](std::uint32_t i) { return begin + i; },
             scratch);
-    } else {
+    } else if (node.sampleIndices != nullptr) {
         const std::uint32_t* indices = node.sampleIndices;
         sumCells(
             cloud, count, fineLevel, origin, [indices](std::uint32_t i) { return indices[i]; },
+            scratch);
+    } else {
+        sumCells(
+            cloud, count, fineLevel, origin, [&node](std::uint32_t i) { return node.heldPoint(i); },
             scratch);
     }
 

@@ -132,6 +132,54 @@ TEST(HierarchyBuilder, ParentsHoldTheRatioOfTheirChildrensPoints) {
     }
 }
 
+// Every sample is the stratified pick of its children's held points, in one list (a
+// paper-collapsed leaf: of its covered range), whether stored or implicit; a sample is stored
+// only when some child does not hold its whole range.
+TEST(HierarchyBuilder, ParentsHoldTheStratifiedPicksOfTheirChildrensPoints) {
+    const auto cloud = makeCloud(Shape::Random, 30000, 11);
+    for (const LeafCollapse collapse :
+         {LeafCollapse::Off, LeafCollapse::Lossless, LeafCollapse::Paper}) {
+        const auto result = buildSynthetic(cloud, checkedOptions(6, collapse));
+        const Hierarchy& hierarchy = result.builder->hierarchy();
+        const auto expectPicks = [](const OctreeNode& node,
+                                    const std::vector<std::uint32_t>& list) {
+            const std::uint64_t n = list.size(), count = node.pointCount;
+            ASSERT_LE(count, n);
+            for (std::uint32_t j = 0; j < count; ++j) {
+                ASSERT_EQ(node.heldPoint(j), list[(2 * j + 1) * n / (2 * count)])
+                    << "node " << std::hex << node.code << std::dec << " pick " << j;
+            }
+        };
+        std::size_t implicitParents = 0, storedParents = 0;
+        for (int level = 0; level < hierarchy.maxLevel(); ++level) {
+            for (std::size_t i = 0; i < hierarchy.nodeCount(level); ++i) {
+                const OctreeNode& node = hierarchy.node(level, i);
+                std::vector<std::uint32_t> list;
+                bool childrenHoldRanges = true;
+                if (node.isLeaf()) {
+                    for (std::uint32_t k = 0; k < node.coveredCount; ++k) {
+                        list.push_back(node.coveredBegin + k);
+                    }
+                } else {
+                    for (std::uint32_t c = 0; c < node.childCount; ++c) {
+                        const OctreeNode& child = hierarchy.node(level + 1, node.firstChild + c);
+                        childrenHoldRanges = childrenHoldRanges && child.holdsRange();
+                        for (std::uint32_t k = 0; k < child.pointCount; ++k) {
+                            list.push_back(child.heldPoint(k));
+                        }
+                    }
+                    (childrenHoldRanges ? implicitParents : storedParents) += 1;
+                }
+                EXPECT_EQ(node.sampleIndices == nullptr, childrenHoldRanges)
+                    << "level " << level << " node " << i;
+                expectPicks(node, list);
+            }
+        }
+        EXPECT_GT(implicitParents, 0u) << toString(collapse);
+        EXPECT_GT(storedParents, 0u) << toString(collapse);
+    }
+}
+
 TEST(HierarchyBuilder, ResultIsIdenticalForEveryThreadCountWorklistAndRangeSize) {
     // Random points plus a dense cluster: many sibling groups straddle worklist boundaries.
     auto cloud = makeCloud(Shape::Random, 30000, 11);

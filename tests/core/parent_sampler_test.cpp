@@ -59,11 +59,13 @@ TEST(ParentSampler, ChildrenSampleDrawsFromEveryChildInProportion) {
                                                     1021, 1030, 1031, 1040, 1041};
     std::array<OctreeNode, 3> nodes{};
     nodes[0].coveredBegin = 0;
-    nodes[0].pointCount = 20;
+    nodes[0].pointCount = nodes[0].coveredCount = 20;
     nodes[1].sampleIndices = childSample.data();
+    nodes[1].coveredBegin = 1000;
+    nodes[1].coveredCount = 50;
     nodes[1].pointCount = static_cast<std::uint32_t>(childSample.size());
     nodes[2].coveredBegin = 5000;
-    nodes[2].pointCount = 10;
+    nodes[2].pointCount = nodes[2].coveredCount = 10;
     const std::array<const OctreeNode*, 3> children = {&nodes[0], &nodes[1], &nodes[2]};
     std::vector<std::uint32_t> out(sampleSize(40, 0.25));
     ASSERT_EQ(out.size(), 10u);
@@ -87,6 +89,60 @@ TEST(ParentSampler, ChildrenSampleDrawsFromEveryChildInProportion) {
     sampleChildren(children, all);
     EXPECT_EQ(all[20], 1000u);
     EXPECT_EQ(all[39], 5009u);
+}
+
+// A parent whose children hold their whole ranges keeps its sample implicit (the builder stores
+// no indices for it): its held points must be exactly the picks sampleChildren stores, and a
+// grandparent must draw the same sample from it as from the stored list.
+TEST(ParentSampler, ImplicitSamplesEqualTheStoredOnes) {
+    const std::array<std::uint32_t, 5> sizes = {7, 1, 30, 12, 3};
+    std::array<OctreeNode, 5> leaves{};
+    std::uint32_t next = 100;
+    for (std::size_t c = 0; c < sizes.size(); ++c) {
+        leaves[c].coveredBegin = next;
+        leaves[c].pointCount = leaves[c].coveredCount = sizes[c];
+        next += sizes[c];
+    }
+    std::array<const OctreeNode*, 5> children{};
+    for (std::size_t c = 0; c < leaves.size(); ++c) {
+        children[c] = &leaves[c];
+    }
+    for (double ratio : {0.01, 0.2, 0.25, 0.5, 0.9, 1.0}) {
+        OctreeNode implicit;
+        implicit.coveredBegin = 100;
+        implicit.coveredCount = next - 100;
+        implicit.pointCount = sampleSize(implicit.coveredCount, ratio);
+        ASSERT_EQ(implicit.holdsImplicitSample(), implicit.pointCount < implicit.coveredCount);
+        std::vector<std::uint32_t> stored(implicit.pointCount);
+        sampleChildren(children, stored);
+        for (std::uint32_t i = 0; i < implicit.pointCount; ++i) {
+            ASSERT_EQ(implicit.heldPoint(i), stored[i]) << "ratio " << ratio << " pick " << i;
+        }
+
+        // The same parent with its list stored, beside a range sibling and a stored sibling.
+        OctreeNode storedParent = implicit;
+        storedParent.sampleIndices = stored.data();
+        OctreeNode rangeSibling;
+        rangeSibling.coveredBegin = next;
+        rangeSibling.pointCount = rangeSibling.coveredCount = 9;
+        const std::vector<std::uint32_t> siblingList = {next + 10, next + 14, next + 15};
+        OctreeNode storedSibling;
+        storedSibling.sampleIndices = siblingList.data();
+        storedSibling.coveredBegin = next + 9;
+        storedSibling.coveredCount = 20;
+        storedSibling.pointCount = 3;
+        const std::uint64_t points = implicit.pointCount + 9 + 3;
+        for (double upper : {0.1, 0.3, 1.0}) {
+            std::vector<std::uint32_t> fromImplicit(sampleSize(points, upper));
+            std::vector<std::uint32_t> fromStored(fromImplicit.size());
+            const std::array<const OctreeNode*, 3> a = {&implicit, &rangeSibling, &storedSibling};
+            const std::array<const OctreeNode*, 3> b = {&storedParent, &rangeSibling,
+                                                        &storedSibling};
+            sampleChildren(a, fromImplicit);
+            sampleChildren(b, fromStored);
+            ASSERT_EQ(fromImplicit, fromStored) << "ratio " << ratio << " upper " << upper;
+        }
+    }
 }
 
 } // namespace
