@@ -31,7 +31,7 @@ constexpr std::size_t kLeafFillGrain = 256;
 struct ParentDraft {
     OctreeNode node; // sampleIndices not set: the sample is in the owning result
     std::uint32_t sampleOffset = 0;
-    bool sampled = false;           // node stores a sample (its pointer set at commit)
+    bool sampled = false;           // node stores its sample (its pointer set at commit)
     bool substituted = false;       // a placeholder became its leaf here
     bool risingPlaceholder = false; // no node: the placeholder moves up as `root`
     CutRoot root;
@@ -39,9 +39,9 @@ struct ParentDraft {
 
 struct WorklistResult {
     std::vector<ParentDraft> drafts;
-    // The drafts' samples. The commit hands the whole buffer to the hierarchy (no copy on
-    // the master thread); the worker reserves it once, for at most a few entries more than
-    // it fills (see samplesBound), so it neither grows nor is trimmed by a copy.
+    // The drafts' stored samples. The commit hands the whole buffer to the hierarchy (no copy
+    // on the master thread); the worker sizes it exactly once its groups are drafted
+    // (sampleDrafts), so it neither grows nor is trimmed by a copy.
     SampleBuffer samples;
     bool ownsSplitGroup = false; // its last group continued into the next worklist
     void clear() {
@@ -51,51 +51,29 @@ struct WorklistResult {
     }
 };
 
-// Whether the parent of these children keeps its sample implicit (OctreeNode::heldPoint): when
-// each holds its whole covered range, together they hold the parent's covered range, and the
-// stratified picks of it are a formula. Most parents of a build are one level above the leaves.
-bool implicitSample(std::span<const OctreeNode* const> children, std::uint64_t covered) {
-    return covered <= kMaxImplicitSampleCovered &&
-           std::all_of(children.begin(), children.end(),
-                       [](const OctreeNode* child) { return child->holdsRange(); });
-}
+// The nodes of a sibling group of `level`, adjacent in Morton order, hence in the level's array.
+struct SiblingNodes {
+    std::array<const OctreeNode*, 8> nodes{};
+    std::size_t count = 0;
+    std::span<const OctreeNode* const> span() const { return {nodes.data(), count}; }
+};
 
-// At least the sample entries the sibling groups of `roots` store: sampleSize(n) <= ratio * n
-// + 1 for a group whose sample is not implicit. Over by about one entry a stored group.
-std::size_t samplesBound(const Hierarchy& hierarchy, const ObliqueCut& cut, double ratio, int level,
-                         std::span<const CutRoot> roots) {
-    std::uint64_t points = 0;
-    std::size_t groups = 0;
-    forEachSiblingGroup(roots, [&](std::span<const CutRoot> group) {
-        if (group.front().placeholder) {
-            const std::uint64_t covered = cut.placeholder(group.front().index).coveredCount;
-            if (covered > kMaxImplicitSampleCovered) {
-                points += covered;
-                ++groups;
-            }
-            return;
-        }
-        bool stored = false;
-        std::uint64_t groupPoints = 0;
-        std::uint64_t groupCovered = 0;
-        for (const CutRoot& root : group) {
-            const OctreeNode& child = hierarchy.node(level, root.index);
-            stored = stored || !child.holdsRange();
-            groupPoints += child.pointCount;
-            groupCovered += child.coveredCount;
-        }
-        if (stored || groupCovered > kMaxImplicitSampleCovered) {
-            points += groupPoints;
-            ++groups;
-        }
-    });
-    return static_cast<std::size_t>(ratio * static_cast<double>(points)) + groups + 1;
+SiblingNodes siblingNodes(const Hierarchy& hierarchy, int level, std::uint32_t first,
+                          std::size_t count) {
+    assert(count <= 8);
+    SiblingNodes siblings;
+    siblings.count = count;
+    for (std::size_t c = 0; c < count; ++c) {
+        siblings.nodes[c] = &hierarchy.node(level, first + c);
+    }
+    return siblings;
 }
 
 // The parent (or substituted leaf, or risen placeholder) replacing `group` of level
 // parentLevel + 1. Reads only published-or-appended nodes and the cut: safe in parallel.
 void draftParent(const Hierarchy& hierarchy, const ObliqueCut& cut, const BuildOptions& options,
-                 int parentLevel, std::span<const CutRoot> group, WorklistResult& out) {
+                 int parentLevel, std::span<const CutRoot> group,
+                 std::vector<ParentDraft>& drafts) {
     ParentDraft draft;
     if (group.front().placeholder) {
         // A placeholder's parent slot holds nothing else (the leaf it stands for had no other
@@ -105,7 +83,7 @@ void draftParent(const Hierarchy& hierarchy, const ObliqueCut& cut, const BuildO
         if (morton::level(placeholder.leafCode) != parentLevel) {
             draft.risingPlaceholder = true;
             draft.root = {group.front().code >> 3, group.front().index, true};
-            out.drafts.push_back(draft);
+            drafts.push_back(draft);
             return;
         }
         OctreeNode& leaf = draft.node;
@@ -117,49 +95,55 @@ void draftParent(const Hierarchy& hierarchy, const ObliqueCut& cut, const BuildO
         leaf.pointCount = placeholder.coveredCount;
         draft.substituted = true;
         if (options.collapse == LeafCollapse::Paper) {
-            // The stratified picks of its range: implicit (OctreeNode::heldPoint) unless huge.
+            // The stratified picks of its range: implicit (OctreeNode::heldPoint).
             leaf.pointCount = sampleSize(placeholder.coveredCount, options.ratio);
-            if (placeholder.coveredCount > kMaxImplicitSampleCovered) {
-                draft.sampled = true;
-                draft.sampleOffset = static_cast<std::uint32_t>(out.samples.size());
-                out.samples.resize(out.samples.size() + leaf.pointCount);
-                sampleRange(placeholder.coveredBegin, placeholder.coveredCount,
-                            std::span(out.samples).subspan(draft.sampleOffset));
-            }
         }
-        out.drafts.push_back(draft);
+        drafts.push_back(draft);
         return;
     }
 
-    std::array<const OctreeNode*, 8> childNodes{};
-    assert(group.size() <= childNodes.size());
-    std::uint64_t childPoints = 0;
     for (std::size_t c = 0; c < group.size(); ++c) {
-        // Siblings are adjacent in Morton order, hence adjacent in their level's array.
         assert(!group[c].placeholder && group[c].index == group.front().index + c);
-        childNodes[c] = &hierarchy.node(parentLevel + 1, group[c].index);
-        childPoints += childNodes[c]->pointCount;
     }
-    const std::span<const OctreeNode* const> children(childNodes.data(), group.size());
+    const SiblingNodes children =
+        siblingNodes(hierarchy, parentLevel + 1, group.front().index, group.size());
     OctreeNode& parent = draft.node;
     parent.code = group.front().code >> 3;
     parent.firstChild = group.front().index;
     parent.childCount = static_cast<std::uint8_t>(group.size());
-    parent.coveredBegin = children.front()->coveredBegin;
-    for (const OctreeNode* child : children) {
+    parent.coveredBegin = children.nodes[0]->coveredBegin;
+    std::uint64_t childPoints = 0;
+    // When every child holds its whole covered range, together they hold the parent's, and the
+    // stratified picks of it are a formula (OctreeNode::heldPoint): the sample is implicit.
+    // Most parents of a build are one level above the leaves, and have no list to store.
+    for (const OctreeNode* child : children.span()) {
         parent.coveredCount += child->coveredCount;
+        childPoints += child->pointCount;
+        draft.sampled = draft.sampled || !child->holdsRange();
     }
     parent.pointCount = sampleSize(childPoints, options.ratio);
-    if (implicitSample(children, parent.coveredCount)) {
-        assert(childPoints == parent.coveredCount);
-        out.drafts.push_back(draft);
-        return;
+    drafts.push_back(draft);
+}
+
+// Fills the stored samples of a worklist's drafts into one buffer of exactly their size.
+void sampleDrafts(const Hierarchy& hierarchy, int parentLevel, WorklistResult& result) {
+    std::uint32_t total = 0;
+    for (ParentDraft& draft : result.drafts) {
+        if (draft.sampled) {
+            draft.sampleOffset = total;
+            total += draft.node.pointCount;
+        }
     }
-    draft.sampled = true;
-    draft.sampleOffset = static_cast<std::uint32_t>(out.samples.size());
-    out.samples.resize(out.samples.size() + parent.pointCount);
-    sampleChildren(children, std::span(out.samples).subspan(draft.sampleOffset));
-    out.drafts.push_back(draft);
+    result.samples.resize(total);
+    for (const ParentDraft& draft : result.drafts) {
+        if (draft.sampled) {
+            const OctreeNode& parent = draft.node;
+            sampleChildren(
+                siblingNodes(hierarchy, parentLevel + 1, parent.firstChild, parent.childCount)
+                    .span(),
+                std::span(result.samples).subspan(draft.sampleOffset, parent.pointCount));
+        }
+    }
 }
 
 } // namespace
@@ -457,13 +441,11 @@ void HierarchyBuilder::fixLevel(int level) {
                 ++last;
             }
         }
-        const std::span<const CutRoot> owned = pending.subspan(first, last - first);
-        const std::size_t bound = samplesBound(*m_hierarchy, m_cut, m_options.ratio, level, owned);
-        result.samples.reserve(bound);
-        forEachSiblingGroup(owned, [&](std::span<const CutRoot> group) {
-            draftParent(*m_hierarchy, m_cut, m_options, level - 1, group, result);
-        });
-        assert(result.samples.size() <= bound); // so the buffer never grew
+        forEachSiblingGroup(
+            pending.subspan(first, last - first), [&](std::span<const CutRoot> group) {
+                draftParent(*m_hierarchy, m_cut, m_options, level - 1, group, result.drafts);
+            });
+        sampleDrafts(*m_hierarchy, level - 1, result);
     };
     if (worklists == 1) {
         runWorklist(0);

@@ -16,9 +16,16 @@
 
 namespace omicron {
 
-// The largest covered range an implicit sample may have: heldPoint's numerator
-// (2i + 1) coveredCount then stays below 2^63. A larger node stores its sample.
-constexpr std::uint64_t kMaxImplicitSampleCovered = std::uint64_t{1} << 31;
+// Pick i of the stratified sample of `count` out of `n` (i < count <= n < 2^32, see
+// parent_sampler.hpp): floor((2i + 1) n / (2 count)). The product takes 65 bits at worst, so
+// it is formed in 128 bits when n makes that possible.
+inline std::uint64_t stratifiedPick(std::uint64_t i, std::uint64_t n, std::uint64_t count) {
+    if (n < (std::uint64_t{1} << 31)) {
+        return (2 * i + 1) * n / (2 * count); // below 2^63
+    }
+    __extension__ using Wide = unsigned __int128;
+    return static_cast<std::uint64_t>(Wide{2 * i + 1} * n / (2 * count));
+}
 
 enum class NodeFlag : std::uint8_t {
     Leaf = 1u << 0,
@@ -61,9 +68,8 @@ struct OctreeNode {
         if (pointCount == coveredCount) {
             return coveredBegin + i;
         }
-        const std::uint64_t numerator = (2 * std::uint64_t{i} + 1) * coveredCount;
         return coveredBegin +
-               static_cast<std::uint32_t>(numerator / (2 * std::uint64_t{pointCount}));
+               static_cast<std::uint32_t>(stratifiedPick(i, coveredCount, pointCount));
     }
 };
 

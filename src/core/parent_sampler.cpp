@@ -47,15 +47,17 @@ public:
     ImplicitHeldPoints(const OctreeNode& node, std::uint64_t k, std::uint64_t step)
         : m_base(node.coveredBegin), m_divisor(2 * std::uint64_t{node.pointCount}), m_k(k),
           m_step(step) {
-        assert(node.holdsImplicitSample() && node.coveredCount <= kMaxImplicitSampleCovered);
+        assert(node.holdsImplicitSample());
         const std::uint64_t n = node.coveredCount;
-        m_quotient = (2 * k + 1) * n / m_divisor;
-        m_remainder = (2 * k + 1) * n % m_divisor;
-        // A step that would leave the node is never taken: should its product wrap (it is
-        // unsigned, so that is defined), the wrapped value is never used.
+        const std::uint64_t m = node.pointCount;
+        m_quotient = stratifiedPick(k, n, m);
+        // Exact modulo 2^64, and the true remainder is below the divisor.
+        m_remainder = (2 * k + 1) * n - m_quotient * m_divisor;
+        // A step of d adds 2dn to the numerator: dn / m whole divisors and 2 (dn % m) over
+        // (dn < 2^64: d and n are point counts).
         for (std::uint64_t s = 0; s < 2; ++s) {
-            m_stepQuotient[s] = 2 * (step + s) * n / m_divisor;
-            m_stepRemainder[s] = 2 * (step + s) * n % m_divisor;
+            m_stepQuotient[s] = (step + s) * n / m;
+            m_stepRemainder[s] = 2 * ((step + s) * n % m);
         }
     }
 

@@ -201,15 +201,10 @@ void estimateNodeSplats(const SortedCloud& cloud, const OctreeNode& node,
     const morton::Cell nodeCell = morton::decode(node.code);
     // Moments relative to the node's corner keep the double sums well conditioned.
     const glm::dvec3 origin = glm::dvec3(nodeCell.x, nodeCell.y, nodeCell.z) * nodeEdge;
-    if (node.holdsRange()) {
+    if (node.holdsRange()) { // most points: the leaves'
         const std::uint32_t begin = node.coveredBegin;
         sumCells(
             cloud, count, fineLevel, origin, [begin](std::uint32_t i) { return begin + i; },
-            scratch);
-    } else if (node.sampleIndices != nullptr) {
-        const std::uint32_t* indices = node.sampleIndices;
-        sumCells(
-            cloud, count, fineLevel, origin, [indices](std::uint32_t i) { return indices[i]; },
             scratch);
     } else {
         sumCells(

@@ -145,5 +145,28 @@ TEST(ParentSampler, ImplicitSamplesEqualTheStoredOnes) {
     }
 }
 
+// Clouds of up to 2^32 - 1 points: (2i + 1) n no longer fits 64 bits, and picks stay exact, in
+// OctreeNode::heldPoint and through an implicit child alike.
+TEST(ParentSampler, PicksAreExactForTheLargestCounts) {
+    const std::uint64_t n = 0xffffffffull, count = n - 1;
+    EXPECT_EQ(stratifiedPick(0, n, count), 0u);
+    EXPECT_EQ(stratifiedPick(count - 1, n, count), n - 1); // floor(n - n / 2count)
+    EXPECT_EQ(stratifiedPick(count / 2, n, count), count / 2 + 1);
+
+    OctreeNode huge;
+    huge.coveredBegin = 0;
+    huge.coveredCount = 4000000000u;
+    huge.pointCount = 3000000000u;
+    ASSERT_TRUE(huge.holdsImplicitSample());
+    std::vector<std::uint32_t> out(1000);
+    const std::array<const OctreeNode*, 1> children = {&huge};
+    sampleChildren(children, out);
+    for (std::uint32_t j = 0; j < out.size(); ++j) {
+        const auto position = static_cast<std::uint32_t>(stratifiedPick(j, huge.pointCount, 1000));
+        ASSERT_EQ(out[j], huge.heldPoint(position)) << "pick " << j;
+    }
+    EXPECT_EQ(huge.heldPoint(huge.pointCount - 1), 3999999999u);
+}
+
 } // namespace
 } // namespace omicron
