@@ -9,9 +9,9 @@
 //     streaming read of the positions on as many threads (the machine's scaling for memory-bound
 //     work). Each figure is the best of 3 runs; (d) of 15, the thread counts alternating.
 #include "bench_timing.hpp"
-#include "hierarchy_builder.hpp"
-#include "morton_sorter.hpp"
-#include "point_reader.hpp"
+#include "build/hierarchy_builder.hpp"
+#include "io/point_reader.hpp"
+#include "sort/morton_sorter.hpp"
 
 #include <algorithm>
 #include <array>

@@ -13,11 +13,11 @@
 // published -> substituted, ms and 60 Hz frames; leaf settled -> substituted, evaluations)
 // and, as the in-run baseline, a whole unsegmented sweep of the final front.
 #include "bench_timing.hpp"
-#include "front.hpp"
-#include "front_projection.hpp"
-#include "hierarchy_builder.hpp"
-#include "morton_sorter.hpp"
-#include "point_reader.hpp"
+#include "build/hierarchy_builder.hpp"
+#include "front/front.hpp"
+#include "front/front_projection.hpp"
+#include "io/point_reader.hpp"
+#include "sort/morton_sorter.hpp"
 
 #include <algorithm>
 #include <atomic>

@@ -8,13 +8,13 @@
 // The files go to a fresh temporary folder, removed at the end. Every time
 // is the best of 3 runs from files the page cache holds (what a second session sees).
 #include "bench_timing.hpp"
-#include "hierarchy_builder.hpp"
-#include "morton_sorter.hpp"
-#include "omh_reader.hpp"
-#include "omh_writer.hpp"
-#include "oms_reader.hpp"
-#include "oms_writer.hpp"
-#include "point_reader.hpp"
+#include "build/hierarchy_builder.hpp"
+#include "formats/omh_reader.hpp"
+#include "formats/omh_writer.hpp"
+#include "formats/oms_reader.hpp"
+#include "formats/oms_writer.hpp"
+#include "io/point_reader.hpp"
+#include "sort/morton_sorter.hpp"
 
 #include <cstdio>
 #include <cstdlib>

@@ -4,7 +4,7 @@
 //
 // usage: morton_bench [POINTS]   (default 20,000,000)
 #include "bench_timing.hpp"
-#include "morton.hpp"
+#include "points/morton.hpp"
 
 #include <array>
 #include <chrono>

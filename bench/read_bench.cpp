@@ -10,10 +10,10 @@
 // phase=open_and_read includes the bounds pre-pass of formats whose header has no bounds;
 // phase=parse passes the bounds in (OpenOptions::knownBounds), so it is the streaming parse.
 #include "bench_timing.hpp"
-#include "las_writer.hpp"
-#include "ply_writer.hpp"
-#include "point_reader.hpp"
-#include "xyz_writer.hpp"
+#include "io/las/las_writer.hpp"
+#include "io/ply/ply_writer.hpp"
+#include "io/point_reader.hpp"
+#include "io/xyz/xyz_writer.hpp"
 
 #include <chrono>
 #include <cstdio>

@@ -8,7 +8,7 @@
 // headless machines).
 #include "bench_timing.hpp"
 #include "cloud_view.hpp"
-#include "build_pipeline.hpp"
+#include "pipeline/build_pipeline.hpp"
 
 #include <QApplication>
 #include <QImage>

@@ -7,9 +7,9 @@
 // 2. The paper's figure 6 for K sort chunks in {1,2,4,8,16,32,64}: read time, time from the
 //    end of reading to the first sorted range, and total sort time after reading.
 #include "bench_timing.hpp"
-#include "morton_sorter.hpp"
-#include "point_reader.hpp"
-#include "radix_sort.hpp"
+#include "io/point_reader.hpp"
+#include "sort/morton_sorter.hpp"
+#include "sort/radix_sort.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -1,10 +1,10 @@
 // Embedding omicron's viewer in a Qt application: build a hierarchy on a background thread
 // and show it while it grows. Usage: omicron-embed-example CLOUD [--snapshot OUT.png]
 // (--snapshot saves one frame once the build is done and quits: used by the test suite).
+#include "build/hierarchy_builder.hpp"
 #include "cloud_view.hpp"
-#include "hierarchy_builder.hpp"
-#include "morton_sorter.hpp"
-#include "point_reader.hpp"
+#include "io/point_reader.hpp"
+#include "sort/morton_sorter.hpp"
 
 #include <QApplication>
 #include <QImage>

@@ -4,7 +4,7 @@
 // hierarchy from the kept sorted points.
 #pragma once
 
-#include "build_pipeline.hpp"
+#include "pipeline/build_pipeline.hpp"
 #include "view_parameters.hpp"
 
 #include <QWidget>

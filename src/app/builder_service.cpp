@@ -1,8 +1,8 @@
 #include "builder_service.hpp"
 
-#include "cloud_export.hpp"
-#include "omh_writer.hpp"
-#include "oms_writer.hpp"
+#include "formats/omh_writer.hpp"
+#include "formats/oms_writer.hpp"
+#include "io/cloud_export.hpp"
 
 #include <QFileInfo>
 #include <QMetaObject>

@@ -10,7 +10,7 @@
 // prompt because every pipeline stage checks the cancel flag between batches.
 #pragma once
 
-#include "build_pipeline.hpp"
+#include "pipeline/build_pipeline.hpp"
 
 #include <QElapsedTimer>
 #include <QObject>

@@ -6,7 +6,7 @@
 // and resident memory.
 #pragma once
 
-#include "build_pipeline.hpp"
+#include "pipeline/build_pipeline.hpp"
 #include "render_settings.hpp"
 
 #include <QElapsedTimer>

@@ -6,7 +6,7 @@
 // Selecting a node emits nodeSelected (the window highlights its cell in the view).
 #pragma once
 
-#include "build_pipeline.hpp"
+#include "pipeline/build_pipeline.hpp"
 
 #include <QWidget>
 #include <memory>

@@ -1,6 +1,6 @@
 #include "hierarchy_model.hpp"
 
-#include "front_projection.hpp"
+#include "front/front_projection.hpp"
 
 #include <QLocale>
 #include <QScopedValueRollback>

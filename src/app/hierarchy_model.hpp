@@ -15,7 +15,7 @@
 // the GUI thread, while the builder threads append.
 #pragma once
 
-#include "hierarchy.hpp"
+#include "build/hierarchy.hpp"
 
 #include <QAbstractItemModel>
 #include <array>

@@ -4,7 +4,7 @@
 // frames: the render front's nodes at each level.
 #pragma once
 
-#include "build_statistics.hpp"
+#include "build/build_statistics.hpp"
 
 #include <QAbstractTableModel>
 #include <span>

@@ -5,7 +5,7 @@
 // are shown in a window-modal dialog (objectName "errorDialog") while the view is kept.
 #pragma once
 
-#include "build_pipeline.hpp"
+#include "pipeline/build_pipeline.hpp"
 #include "view_parameters.hpp"
 
 #include <QElapsedTimer>

@@ -1,6 +1,6 @@
 #include "cli_args.hpp"
 
-#include "morton_sorter.hpp"
+#include "sort/morton_sorter.hpp"
 
 #include <algorithm>
 #include <charconv>

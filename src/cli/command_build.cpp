@@ -2,10 +2,10 @@
 // builder), then the build statistics as text or JSON.
 #include "cli_args.hpp"
 #include "commands.hpp"
-#include "build_pipeline.hpp"
+#include "formats/omh_writer.hpp"
 #include "json_writer.hpp"
 #include "levels_json.hpp"
-#include "omh_writer.hpp"
+#include "pipeline/build_pipeline.hpp"
 
 #include <chrono>
 #include <cstdio>

@@ -2,13 +2,13 @@
 // chosen by OUT's extension.
 #include "cli_args.hpp"
 #include "commands.hpp"
-#include "las_writer.hpp"
-#include "morton_sorter.hpp"
-#include "oms_reader.hpp"
-#include "oms_writer.hpp"
-#include "ply_writer.hpp"
-#include "point_reader.hpp"
-#include "xyz_writer.hpp"
+#include "formats/oms_reader.hpp"
+#include "formats/oms_writer.hpp"
+#include "io/las/las_writer.hpp"
+#include "io/ply/ply_writer.hpp"
+#include "io/point_reader.hpp"
+#include "io/xyz/xyz_writer.hpp"
+#include "sort/morton_sorter.hpp"
 
 #include <algorithm>
 #include <cctype>

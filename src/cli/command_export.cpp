@@ -2,8 +2,8 @@
 // so any tool can inspect a sorted file.
 #include "cli_args.hpp"
 #include "commands.hpp"
-#include "oms_reader.hpp"
-#include "ply_writer.hpp"
+#include "formats/oms_reader.hpp"
+#include "io/ply/ply_writer.hpp"
 
 #include <cstdio>
 

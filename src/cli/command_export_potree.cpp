@@ -2,8 +2,8 @@
 // Potree and the tools that read PotreeConverter 2's output.
 #include "cli_args.hpp"
 #include "commands.hpp"
-#include "omh_reader.hpp"
-#include "potree_writer.hpp"
+#include "formats/omh_reader.hpp"
+#include "formats/potree_writer.hpp"
 
 #include <cstdio>
 #include <filesystem>

@@ -2,9 +2,9 @@
 // as XYZ text when OUT ends in .xyz.
 #include "cli_args.hpp"
 #include "commands.hpp"
-#include "ply_writer.hpp"
-#include "scene_generator.hpp"
-#include "xyz_writer.hpp"
+#include "io/ply/ply_writer.hpp"
+#include "io/xyz/xyz_writer.hpp"
+#include "scene/scene_generator.hpp"
 
 #include <chrono>
 #include <cstdint>

@@ -2,11 +2,11 @@
 // how fast it was read.
 #include "cli_args.hpp"
 #include "commands.hpp"
+#include "formats/omh_reader.hpp"
+#include "formats/oms_reader.hpp"
+#include "io/point_reader.hpp"
 #include "json_writer.hpp"
-#include "oms_reader.hpp"
 #include "omh_info.hpp"
-#include "omh_reader.hpp"
-#include "point_reader.hpp"
 
 #include <chrono>
 #include <cstdio>

@@ -1,12 +1,12 @@
 // omicron-cli render: the full pipeline (unsorted cloud or .oms -> builder), then one image of
 // the finished hierarchy through the same CloudView the application shows, without a visible
 // window. Needs a display for the OpenGL context (under CI: xvfb-run).
-#include "atomic_file_writer.hpp"
-#include "build_pipeline.hpp"
 #include "cli_args.hpp"
 #include "cloud_view.hpp"
 #include "commands.hpp"
-#include "input_error.hpp"
+#include "io/atomic_file_writer.hpp"
+#include "io/input_error.hpp"
+#include "pipeline/build_pipeline.hpp"
 
 #include <QApplication>
 #include <QBuffer>

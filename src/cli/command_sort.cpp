@@ -2,11 +2,11 @@
 // order and writes the sorted stream (.oms) while the sorted ranges come out.
 #include "cli_args.hpp"
 #include "commands.hpp"
-#include "input_error.hpp"
-#include "morton_sorter.hpp"
-#include "oms_writer.hpp"
-#include "point_reader.hpp"
+#include "formats/oms_writer.hpp"
+#include "io/input_error.hpp"
+#include "io/point_reader.hpp"
 #include "progress_line.hpp"
+#include "sort/morton_sorter.hpp"
 
 #include <chrono>
 #include <cstdio>

@@ -1,9 +1,9 @@
 // omicron-cli: the headless front end. Dispatches to a command and turns errors into exit
 // statuses: 0 ok, 1 input or output error, 2 usage error.
-#include "atomic_file_writer.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
-#include "input_error.hpp"
+#include "io/atomic_file_writer.hpp"
+#include "io/input_error.hpp"
 
 #include <array>
 #include <cstdio>

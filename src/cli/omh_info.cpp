@@ -1,8 +1,8 @@
 #include "omh_info.hpp"
 
+#include "formats/omh_reader.hpp"
 #include "json_writer.hpp"
 #include "levels_json.hpp"
-#include "omh_reader.hpp"
 
 #include <cstdio>
 #include <string>

@@ -1,6 +1,6 @@
 #include "cloud_node.hpp"
 
-#include "hierarchy.hpp"
+#include "build/hierarchy.hpp"
 #include "shader_library.hpp"
 #include "view_camera.hpp"
 

@@ -5,7 +5,7 @@
 
 #include "compute_rasterizer.hpp"
 #include "first_draw_tracker.hpp"
-#include "front.hpp"
+#include "front/front.hpp"
 #include "node_buffer_cache.hpp"
 #include "node_vertices.hpp"
 #include "scene_node.hpp"

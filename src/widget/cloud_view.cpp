@@ -1,10 +1,10 @@
 #include "cloud_view.hpp"
 
 #include "axis_gizmo_node.hpp"
+#include "build/hierarchy.hpp"
 #include "cloud_node.hpp"
-#include "hierarchy.hpp"
-#include "morton_sorter.hpp"
 #include "overlay_node.hpp"
+#include "sort/morton_sorter.hpp"
 #include "view_camera.hpp"
 
 #include <QElapsedTimer>

@@ -1,6 +1,6 @@
 #include "first_draw_tracker.hpp"
 
-#include "hierarchy.hpp"
+#include "build/hierarchy.hpp"
 
 #include <algorithm>
 

@@ -1,7 +1,7 @@
 #include "node_vertices.hpp"
 
-#include "hierarchy.hpp"
-#include "splat_encoding.hpp"
+#include "build/hierarchy.hpp"
+#include "build/splat_encoding.hpp"
 
 #include <algorithm>
 #include <cmath>

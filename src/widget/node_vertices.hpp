@@ -7,7 +7,7 @@
 // area), read from the file for a loaded hierarchy (with the node's splatScale applied).
 #pragma once
 
-#include "splat_estimator.hpp"
+#include "build/splat_estimator.hpp"
 
 #include <cstdint>
 #include <span>

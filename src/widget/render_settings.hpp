@@ -1,7 +1,7 @@
 // Value types of the CloudView API: what to draw and how, and what a frame cost.
 #pragma once
 
-#include "morton.hpp"
+#include "points/morton.hpp"
 
 #include <QMetaType>
 #include <array>

@@ -3,9 +3,9 @@
 // reports bad files by name, and stops promptly on cancel and destruction.
 #include "app_test_support.hpp"
 #include "builder_service.hpp"
-#include "ply_writer.hpp"
-#include "point_reader.hpp"
-#include "scene_generator.hpp"
+#include "io/ply/ply_writer.hpp"
+#include "io/point_reader.hpp"
+#include "scene/scene_generator.hpp"
 
 #include <QElapsedTimer>
 #include <QFile>

@@ -2,11 +2,11 @@
 // in source units, points held and covered, children, and emits nodeSelected for the view's
 // highlight; a new hierarchy clears it), a selection that survives its row moving under a
 // parent that settles while a build runs, and the read bar during a bounds pre-pass.
-#include "build_pipeline.hpp"
+#include "build/hierarchy_builder.hpp"
 #include "cut_panel.hpp"
-#include "hierarchy_builder.hpp"
 #include "hierarchy_model.hpp"
 #include "level_model.hpp"
+#include "pipeline/build_pipeline.hpp"
 #include "widget_test_support.hpp"
 
 #include <QAbstractItemModelTester>

@@ -3,11 +3,11 @@
 // level in Morton order; the complete hierarchy rooted at level 0 with every node reachable
 // through lazily fetched children; a new hierarchy resets the model; indexOfNode fetches the
 // path to a deep node; a .omh file loading top-down (pipeline 3) fills expanded rows.
-#include "build_pipeline.hpp"
-#include "hierarchy_builder.hpp"
+#include "build/hierarchy_builder.hpp"
+#include "formats/omh_reader.hpp"
+#include "formats/omh_writer.hpp"
 #include "hierarchy_model.hpp"
-#include "omh_reader.hpp"
-#include "omh_writer.hpp"
+#include "pipeline/build_pipeline.hpp"
 #include "widget_test_support.hpp"
 
 #include <QAbstractItemModelTester>

@@ -1,7 +1,7 @@
 // omicron-cli build --json on real scans: per-level node counts equal a brute-force octree of
 // the same depth, from unsorted input (pipeline 1) and from a .oms (pipeline 2) alike.
-#include "morton.hpp"
-#include "point_reader.hpp"
+#include "io/point_reader.hpp"
+#include "points/morton.hpp"
 #include "run_process.hpp"
 #include "test_files.hpp"
 

@@ -1,7 +1,7 @@
 // omicron-cli sort and export, run as real processes on every shared scan: the exported PLY
 // holds the input's points in non-decreasing Morton order of the input's cube.
-#include "oms_reader.hpp"
-#include "point_reader.hpp"
+#include "formats/oms_reader.hpp"
+#include "io/point_reader.hpp"
 #include "run_process.hpp"
 #include "test_files.hpp"
 

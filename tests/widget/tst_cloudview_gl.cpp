@@ -1,10 +1,10 @@
 // CloudView under a real GL context (Xvfb + Mesa llvmpipe in CI): what it draws, checked by
 // pixel statistics of renderImage() from fixed cameras.
-#include "build_pipeline.hpp"
+#include "build/hierarchy_builder.hpp"
 #include "cloud_view.hpp"
-#include "hierarchy_builder.hpp"
-#include "morton_sorter.hpp"
-#include "point_reader.hpp"
+#include "io/point_reader.hpp"
+#include "pipeline/build_pipeline.hpp"
+#include "sort/morton_sorter.hpp"
 #include "widget_test_support.hpp"
 
 #include <QElapsedTimer>

@@ -4,8 +4,8 @@
 // statistics of renderImage() and grabFramebuffer() from fixed cameras.
 #include "cloud_view.hpp"
 #include "compute_rasterizer.hpp"
-#include "cube_transform.hpp"
-#include "morton_sorter.hpp"
+#include "points/cube_transform.hpp"
+#include "sort/morton_sorter.hpp"
 #include "widget_test_support.hpp"
 
 #include <QOpenGLContext>

@@ -1,9 +1,9 @@
 // FirstDrawTracker (no GL): over a real build's insertion log, a leaf counts as drawn once a
 // drawn range covers it (its own node or an ancestor), exactly once, and leaves published
 // before the attach are not measured.
-#include "build_pipeline.hpp"
+#include "build/hierarchy.hpp"
 #include "first_draw_tracker.hpp"
-#include "hierarchy.hpp"
+#include "pipeline/build_pipeline.hpp"
 
 #include <QtTest>
 #include <vector>

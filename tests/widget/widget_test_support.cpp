@@ -1,7 +1,7 @@
 #include "widget_test_support.hpp"
 
-#include "build_pipeline.hpp"
-#include "scene_generator.hpp"
+#include "pipeline/build_pipeline.hpp"
+#include "scene/scene_generator.hpp"
 
 #include <QFileInfo>
 #include <cstdlib>

@@ -2,9 +2,9 @@
 // finished hierarchies, a generated scene sorted into ranges, image statistics.
 #pragma once
 
-#include "build_options.hpp"
-#include "hierarchy.hpp"
-#include "morton_sorter.hpp"
+#include "build/build_options.hpp"
+#include "build/hierarchy.hpp"
+#include "sort/morton_sorter.hpp"
 
 #include <QColor>
 #include <QImage>

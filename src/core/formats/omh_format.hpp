@@ -1,0 +1,176 @@
+// The .omh hierarchy file: a finished OMiCroN hierarchy, stored so that it reloads top-down,
+// level by level (the paper's pipeline 3): a viewer draws the root while deeper levels load.
+//
+// Layout (all little-endian, 64-bit offsets and counts; docs/FORMATS.md has the byte tables):
+//   header       256 bytes  magic "OMICRONH", version, endianness marker, totals, build
+//                           parameters (depth, ratio, collapse), attribute layout, cube and
+//                           source offset; XXH64 of the 248 bytes before it
+//   level table  L x 56 + 8 per level: nodes, leaves, points, node-table and payload offsets,
+//                           XXH3-64 of the level's node records and of its point records;
+//                           then XXH64 of the entries
+//   node table   32 bytes per node, breadth first: level 0, then level 1 ... each level in
+//                           Morton order (code, first point, point count, splat scale, child
+//                           mask, flags)
+//   payload      R bytes per held point, grouped by node in node-table order
+//   footer       32 bytes   magic "OMHEND\0\0", total nodes, total points, XXH64 of them
+//
+// Each level has its own checksums so a progressive reader verifies a level before it
+// publishes it; nothing from a damaged section ever reaches a renderer.
+#pragma once
+
+#include "build/build_options.hpp"
+#include "formats/oms_format.hpp"
+#include "points/cube_transform.hpp"
+#include "points/point_batch.hpp"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <glm/vec3.hpp>
+#include <string>
+#include <vector>
+
+namespace omicron::omh {
+
+inline constexpr std::array<char, 8> kMagic{'O', 'M', 'I', 'C', 'R', 'O', 'N', 'H'};
+inline constexpr std::array<char, 8> kFooterMagic{'O', 'M', 'H', 'E', 'N', 'D', '\0', '\0'};
+inline constexpr std::uint32_t kVersion = 1;
+inline constexpr std::uint32_t kEndiannessMarker = oms::kEndiannessMarker;
+inline constexpr std::uint8_t kKnownAttributeBits = oms::kKnownAttributeBits;
+// Splat bit 0: each record carries the estimated normal (the cloud has no normals of its own).
+inline constexpr std::uint8_t kSplatEstimatedNormal = 0x01;
+inline constexpr std::uint8_t kKnownNodeFlags = 0x03; // NodeFlag::Leaf | NodeFlag::Collapsed
+
+inline constexpr std::size_t kHeaderBytes = 256;
+inline constexpr std::size_t kLevelEntryBytes = 56;
+inline constexpr std::size_t kNodeRecordBytes = 32;
+inline constexpr std::size_t kFooterBytes = 32;
+
+namespace header {
+inline constexpr std::size_t kMagic = 0;            // char[8]
+inline constexpr std::size_t kVersion = 8;          // u32
+inline constexpr std::size_t kEndianness = 12;      // u32
+inline constexpr std::size_t kTotalNodes = 16;      // u64
+inline constexpr std::size_t kTotalPoints = 24;     // u64, payload records
+inline constexpr std::size_t kInputPoints = 32;     // u64, points of the source cloud
+inline constexpr std::size_t kDroppedPoints = 40;   // u64, LeafCollapse::Paper
+inline constexpr std::size_t kCollapsedLeaves = 48; // u64
+inline constexpr std::size_t kMaxLevel = 56;        // u8, 1..21
+inline constexpr std::size_t kLevelCount = 57;      // u8, max level + 1
+inline constexpr std::size_t kCollapse = 58;        // u8, 0 off, 1 lossless, 2 paper
+inline constexpr std::size_t kAttributes = 59;      // u8, AttributeSet::bits()
+inline constexpr std::size_t kSplatBits = 60;       // u8
+inline constexpr std::size_t kReserved0 = 61;       // u8, zero
+inline constexpr std::size_t kRecordBytes = 62;     // u16
+inline constexpr std::size_t kRatio = 64;           // f64, (0, 1]
+inline constexpr std::size_t kCubeOrigin = 72;      // f64[3]
+inline constexpr std::size_t kCubeEdge = 96;        // f64, > 0
+inline constexpr std::size_t kSourceOffset = 104;   // f64[3]
+inline constexpr std::size_t kReserved1 = 128;      // 120 zero bytes
+inline constexpr std::size_t kChecksum = 248;       // u64, XXH64 of bytes [0, 248)
+} // namespace header
+
+namespace level {
+inline constexpr std::size_t kNodes = 0;             // u64
+inline constexpr std::size_t kLeaves = 8;            // u64
+inline constexpr std::size_t kPoints = 16;           // u64, records held by the level's nodes
+inline constexpr std::size_t kNodeTableOffset = 24;  // u64, absolute byte offset
+inline constexpr std::size_t kPayloadOffset = 32;    // u64, absolute byte offset
+inline constexpr std::size_t kNodeChecksum = 40;     // u64, XXH3-64 of the level's node records
+inline constexpr std::size_t kPayloadChecksum = 48;  // u64, XXH3-64 of the level's records
+} // namespace level
+
+namespace node {
+inline constexpr std::size_t kCode = 0;        // u64, Morton code with sentinel bit
+inline constexpr std::size_t kFirstPoint = 8;  // u64, first record, counted from the payload start
+inline constexpr std::size_t kPointCount = 16; // u64, >= 1
+inline constexpr std::size_t kSplatScale = 24; // f32, finite, > 0
+inline constexpr std::size_t kChildMask = 28;  // u8, bit o: the child with octant o exists
+inline constexpr std::size_t kFlags = 29;      // u8, NodeFlag bits
+inline constexpr std::size_t kReserved = 30;   // u16, zero
+} // namespace node
+
+namespace footer {
+inline constexpr std::size_t kMagic = 0;       // char[8]
+inline constexpr std::size_t kTotalNodes = 8;  // u64
+inline constexpr std::size_t kTotalPoints = 16; // u64
+inline constexpr std::size_t kChecksum = 24;   // u64, XXH64 of footer bytes [0, 24)
+} // namespace footer
+
+// A point record: the .oms record (position, optional normal, colour, intensity), then the
+// splat radius (encodeRadius) and, when the splat bit says so, the octahedral estimated normal.
+struct RecordLayout {
+    oms::RecordLayout point;
+    std::size_t radiusOffset = 0;
+    std::size_t estimatedNormalOffset = 0;
+    std::size_t bytes = 0;
+
+    static constexpr RecordLayout of(AttributeSet attributes, bool estimatedNormal) {
+        RecordLayout layout;
+        layout.point = oms::RecordLayout::of(attributes);
+        layout.radiusOffset = layout.point.bytes;
+        std::size_t at = layout.radiusOffset + sizeof(std::uint16_t);
+        if (estimatedNormal) {
+            layout.estimatedNormalOffset = at;
+            at += sizeof(std::uint32_t);
+        }
+        layout.bytes = at;
+        return layout;
+    }
+};
+
+// What determines the stored hierarchy besides its input, and the build's counts worth keeping.
+struct BuildInfo {
+    int maxLevel = 7;
+    double ratio = 0.2;
+    LeafCollapse collapse = LeafCollapse::Off;
+    std::uint64_t inputPoints = 0;
+    std::uint64_t droppedPoints = 0;
+    std::uint64_t collapsedLeaves = 0;
+};
+
+struct LevelEntry {
+    std::uint64_t nodes = 0;
+    std::uint64_t leaves = 0;
+    std::uint64_t points = 0;
+    std::uint64_t nodeTableOffset = 0;
+    std::uint64_t payloadOffset = 0;
+    std::uint64_t nodeChecksum = 0;
+    std::uint64_t payloadChecksum = 0;
+};
+
+// Everything the header and level table say.
+struct Header {
+    std::string path;
+    std::uint32_t version = kVersion;
+    std::uint64_t fileBytes = 0;
+    BuildInfo build;
+    AttributeSet attributes;
+    bool estimatedNormals = false;
+    std::size_t recordBytes = 0;
+    CubeTransform cube;
+    glm::dvec3 sourceOffset{0.0};
+    std::uint64_t totalNodes = 0;
+    std::uint64_t totalPoints = 0;
+    std::vector<LevelEntry> levels; // index = level, 0..maxLevel
+
+    std::uint64_t levelTableOffset() const { return kHeaderBytes; }
+    std::uint64_t nodeTableOffset() const {
+        return kHeaderBytes + levels.size() * kLevelEntryBytes + 8;
+    }
+    std::uint64_t payloadOffset() const { return nodeTableOffset() + totalNodes * kNodeRecordBytes; }
+    std::uint64_t footerOffset() const { return payloadOffset() + totalPoints * recordBytes; }
+};
+
+std::uint8_t encodeCollapse(LeafCollapse collapse);
+
+// XXH64 (seed 0) of small fixed sections (header, level table, footer).
+std::uint64_t smallChecksum(const void* bytes, std::size_t count);
+
+std::array<std::uint8_t, kHeaderBytes> encodeHeader(const Header& header);
+// The level entries and their checksum, levels.size() * kLevelEntryBytes + 8 bytes.
+std::vector<std::uint8_t> encodeLevelTable(const std::vector<LevelEntry>& levels);
+std::array<std::uint8_t, kFooterBytes> encodeFooter(std::uint64_t totalNodes,
+                                                    std::uint64_t totalPoints);
+
+} // namespace omicron::omh

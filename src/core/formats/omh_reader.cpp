@@ -1,0 +1,616 @@
+#include "formats/omh_reader.hpp"
+
+#include "io/input_error.hpp"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+
+namespace omicron {
+
+namespace {
+
+// Point records are read and decoded in blocks of about this size.
+constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
+
+template <typename T> T loadLe(const std::uint8_t* at) {
+    T value;
+    std::memcpy(&value, at, sizeof(T));
+    return value;
+}
+
+std::string hex(std::uint64_t value) {
+    char text[19];
+    std::snprintf(text, sizeof(text), "0x%016llx", static_cast<unsigned long long>(value));
+    return text;
+}
+
+bool isFinite(const glm::dvec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+glm::dvec3 loadDvec3(const std::uint8_t* at) {
+    return {loadLe<double>(at), loadLe<double>(at + 8), loadLe<double>(at + 16)};
+}
+
+std::string range(std::uint64_t begin, std::uint64_t end) {
+    return "bytes " + std::to_string(begin) + "-" + std::to_string(end == 0 ? 0 : end - 1);
+}
+
+std::string levelName(int level) {
+    return "level " + std::to_string(level);
+}
+
+std::uint64_t checksumOf(const std::uint8_t* bytes, std::size_t count) {
+    oms::PayloadChecksum checksum;
+    checksum.update(bytes, count);
+    return checksum.digest();
+}
+
+} // namespace
+
+bool isOmhFile(const std::string& path) {
+    std::string extension = std::filesystem::path(path).extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (extension == ".omh") {
+        return true;
+    }
+    try {
+        FileStream stream(path);
+        std::array<char, 8> magic{};
+        return stream.read(magic.data(), magic.size()) == magic.size() && magic == omh::kMagic;
+    } catch (const InputError&) {
+        return false;
+    }
+}
+
+std::string omhSectionAt(const omh::Header& header, std::uint64_t offset) {
+    if (offset < omh::kHeaderBytes) {
+        return "the header (" + range(0, omh::kHeaderBytes) + ")";
+    }
+    if (offset < header.nodeTableOffset()) {
+        return "the level table (" + range(omh::kHeaderBytes, header.nodeTableOffset()) + ")";
+    }
+    for (std::size_t l = 0; l < header.levels.size(); ++l) {
+        const omh::LevelEntry& e = header.levels[l];
+        const std::uint64_t end = e.nodeTableOffset + e.nodes * omh::kNodeRecordBytes;
+        if (offset >= e.nodeTableOffset && offset < end) {
+            return "the node table of " + levelName(static_cast<int>(l)) + " (" +
+                   range(e.nodeTableOffset, end) + ")";
+        }
+    }
+    for (std::size_t l = 0; l < header.levels.size(); ++l) {
+        const omh::LevelEntry& e = header.levels[l];
+        const std::uint64_t end = e.payloadOffset + e.points * header.recordBytes;
+        if (offset >= e.payloadOffset && offset < end) {
+            return "the point records of " + levelName(static_cast<int>(l)) + " (" +
+                   range(e.payloadOffset, end) + ")";
+        }
+    }
+    const std::uint64_t footer = header.footerOffset();
+    return "the footer (" + range(footer, footer + omh::kFooterBytes) + ")";
+}
+
+OmhReader::OmhReader(const std::string& path) : m_stream(path) {
+    namespace h = omh::header;
+    const auto error = [&](InputErrorKind kind, std::uint64_t byte, const std::string& detail) {
+        return InputError(kind, path, InputLocation::byte(byte), detail);
+    };
+    const std::uint64_t fileBytes = m_stream.size();
+    if (fileBytes == 0) {
+        throw InputError(InputErrorKind::EmptyFile, path, InputLocation::none(),
+                         "the file is empty (0 bytes), expected a .omh hierarchy file");
+    }
+    std::array<std::uint8_t, omh::kHeaderBytes> header{};
+    const std::size_t got = m_stream.read(header.data(), header.size());
+    if (std::memcmp(header.data(), omh::kMagic.data(), std::min(got, omh::kMagic.size())) != 0) {
+        throw error(InputErrorKind::UnknownFormat, 0,
+                    "in the header: expected the .omh magic 'OMICRONH'");
+    }
+    if (got < omh::kHeaderBytes) {
+        throw error(InputErrorKind::Truncated, fileBytes,
+                    "the file ends inside the header (" + range(0, omh::kHeaderBytes) +
+                        "), expected " + std::to_string(omh::kHeaderBytes) + " header bytes");
+    }
+    const auto endianness = loadLe<std::uint32_t>(header.data() + h::kEndianness);
+    if (endianness == __builtin_bswap32(omh::kEndiannessMarker)) {
+        throw error(InputErrorKind::UnsupportedFeature, h::kEndianness,
+                    "in the header: the file was written in big-endian byte order; only "
+                    "little-endian .omh files are supported");
+    }
+    if (endianness != omh::kEndiannessMarker) {
+        throw error(InputErrorKind::MalformedHeader, h::kEndianness,
+                    "in the header: expected the endianness marker bytes 04 03 02 01");
+    }
+    const auto version = loadLe<std::uint32_t>(header.data() + h::kVersion);
+    if (version != omh::kVersion) {
+        throw error(InputErrorKind::UnsupportedFeature, h::kVersion,
+                    "in the header: expected .omh format version " + std::to_string(omh::kVersion) +
+                        ", found " + std::to_string(version));
+    }
+    const auto storedChecksum = loadLe<std::uint64_t>(header.data() + h::kChecksum);
+    const std::uint64_t headerChecksum = omh::smallChecksum(header.data(), h::kChecksum);
+    if (storedChecksum != headerChecksum) {
+        throw error(InputErrorKind::MalformedHeader, h::kChecksum,
+                    "header checksum mismatch: the header stores XXH64 " + hex(storedChecksum) +
+                        " for bytes 0-" + std::to_string(h::kChecksum - 1) + ", they hash to " +
+                        hex(headerChecksum) + ": the header is damaged");
+    }
+
+    // The checksum matched, so what follows can only fail for a file that a writer other than
+    // omicron's made wrongly: still checked, so nothing below trusts a field blindly.
+    const auto malformed = [&](std::size_t byte, const std::string& detail) {
+        return error(InputErrorKind::MalformedHeader, byte, "in the header: " + detail);
+    };
+    omh::Header& info = m_header;
+    info.path = path;
+    info.version = version;
+    info.fileBytes = fileBytes;
+    info.totalNodes = loadLe<std::uint64_t>(header.data() + h::kTotalNodes);
+    info.totalPoints = loadLe<std::uint64_t>(header.data() + h::kTotalPoints);
+    info.build.inputPoints = loadLe<std::uint64_t>(header.data() + h::kInputPoints);
+    info.build.droppedPoints = loadLe<std::uint64_t>(header.data() + h::kDroppedPoints);
+    info.build.collapsedLeaves = loadLe<std::uint64_t>(header.data() + h::kCollapsedLeaves);
+    const int maxLevel = header[h::kMaxLevel];
+    if (maxLevel < 1 || maxLevel > morton::kMaxLevel) {
+        throw malformed(h::kMaxLevel,
+                        "expected a depth of 1-21, found " + std::to_string(maxLevel));
+    }
+    info.build.maxLevel = maxLevel;
+    if (header[h::kLevelCount] != maxLevel + 1) {
+        throw malformed(h::kLevelCount, "expected " + std::to_string(maxLevel + 1) +
+                                            " levels for depth " + std::to_string(maxLevel));
+    }
+    switch (header[h::kCollapse]) {
+    case 0:
+        info.build.collapse = LeafCollapse::Off;
+        break;
+    case 1:
+        info.build.collapse = LeafCollapse::Lossless;
+        break;
+    case 2:
+        info.build.collapse = LeafCollapse::Paper;
+        break;
+    default:
+        throw malformed(h::kCollapse, "expected leaf collapse 0, 1 or 2");
+    }
+    const std::uint8_t attributeBits = header[h::kAttributes];
+    if ((attributeBits & ~omh::kKnownAttributeBits) != 0) {
+        throw malformed(h::kAttributes, "unknown attribute bits");
+    }
+    for (Attribute a : {Attribute::Normal, Attribute::Color, Attribute::Intensity}) {
+        if ((attributeBits & static_cast<std::uint8_t>(a)) != 0) {
+            info.attributes.add(a);
+        }
+    }
+    const std::uint8_t splatBits = header[h::kSplatBits];
+    // The builder estimates normals exactly when the cloud has none of its own.
+    const bool expectedEstimate = !info.attributes.has(Attribute::Normal);
+    if (splatBits != (expectedEstimate ? omh::kSplatEstimatedNormal : 0)) {
+        throw malformed(h::kSplatBits,
+                        "expected splat bits " + std::to_string(expectedEstimate ? 1 : 0) +
+                            " for these attributes, found " + std::to_string(splatBits));
+    }
+    info.estimatedNormals = expectedEstimate;
+    m_layout = omh::RecordLayout::of(info.attributes, info.estimatedNormals);
+    info.recordBytes = loadLe<std::uint16_t>(header.data() + h::kRecordBytes);
+    if (info.recordBytes != m_layout.bytes) {
+        throw malformed(h::kRecordBytes, "expected a record size of " +
+                                             std::to_string(m_layout.bytes) + " bytes, found " +
+                                             std::to_string(info.recordBytes));
+    }
+    for (std::size_t at : {h::kReserved0}) {
+        if (header[at] != 0) {
+            throw malformed(at, "expected a reserved zero byte");
+        }
+    }
+    for (std::size_t at = h::kReserved1; at < h::kChecksum; ++at) {
+        if (header[at] != 0) {
+            throw malformed(at, "expected reserved bytes " + std::to_string(h::kReserved1) + "-" +
+                                    std::to_string(h::kChecksum - 1) + " to be zero");
+        }
+    }
+    info.build.ratio = loadLe<double>(header.data() + h::kRatio);
+    if (!(info.build.ratio > 0.0 && info.build.ratio <= 1.0)) {
+        throw malformed(h::kRatio, "expected a ratio in (0, 1]");
+    }
+    info.cube = CubeTransform{loadDvec3(header.data() + h::kCubeOrigin),
+                              loadLe<double>(header.data() + h::kCubeEdge)};
+    info.sourceOffset = loadDvec3(header.data() + h::kSourceOffset);
+    if (!isFinite(info.cube.origin) || !isFinite(info.sourceOffset)) {
+        throw malformed(h::kCubeOrigin, "expected a finite cube origin and source offset");
+    }
+    if (!std::isfinite(info.cube.edge) || !(info.cube.edge > 0.0)) {
+        throw malformed(h::kCubeEdge, "expected a finite cube edge > 0");
+    }
+    if (info.totalNodes == 0 || info.totalPoints < info.totalNodes) {
+        throw malformed(h::kTotalNodes, "expected at least one node and a point per node");
+    }
+
+    // Level table.
+    const std::size_t levelCount = static_cast<std::size_t>(maxLevel) + 1;
+    const std::uint64_t tableBytes = levelCount * omh::kLevelEntryBytes + 8;
+    if (fileBytes < omh::kHeaderBytes + tableBytes) {
+        throw error(InputErrorKind::Truncated, fileBytes,
+                    "the file ends inside the level table (" +
+                        range(omh::kHeaderBytes, omh::kHeaderBytes + tableBytes) + ")");
+    }
+    std::vector<std::uint8_t> table(tableBytes);
+    m_stream.readExact(table.data(), table.size(), "the level table");
+    const std::uint64_t entryBytes = levelCount * omh::kLevelEntryBytes;
+    const auto storedTableChecksum = loadLe<std::uint64_t>(table.data() + entryBytes);
+    const std::uint64_t tableChecksum = omh::smallChecksum(table.data(), entryBytes);
+    if (storedTableChecksum != tableChecksum) {
+        throw error(InputErrorKind::MalformedHeader, omh::kHeaderBytes + entryBytes,
+                    "level table checksum mismatch: it stores XXH64 " + hex(storedTableChecksum) +
+                        " for " + range(omh::kHeaderBytes, omh::kHeaderBytes + entryBytes) +
+                        ", they hash to " + hex(tableChecksum) + ": the level table is damaged");
+    }
+    info.levels.resize(levelCount);
+    std::uint64_t nodes = 0, points = 0;
+    for (std::size_t l = 0; l < levelCount; ++l) {
+        const std::uint8_t* at = table.data() + l * omh::kLevelEntryBytes;
+        omh::LevelEntry& e = info.levels[l];
+        e.nodes = loadLe<std::uint64_t>(at + omh::level::kNodes);
+        e.leaves = loadLe<std::uint64_t>(at + omh::level::kLeaves);
+        e.points = loadLe<std::uint64_t>(at + omh::level::kPoints);
+        e.nodeTableOffset = loadLe<std::uint64_t>(at + omh::level::kNodeTableOffset);
+        e.payloadOffset = loadLe<std::uint64_t>(at + omh::level::kPayloadOffset);
+        e.nodeChecksum = loadLe<std::uint64_t>(at + omh::level::kNodeChecksum);
+        e.payloadChecksum = loadLe<std::uint64_t>(at + omh::level::kPayloadChecksum);
+        const std::uint64_t byte = omh::kHeaderBytes + l * omh::kLevelEntryBytes;
+        const auto bad = [&](const std::string& detail) {
+            return error(InputErrorKind::MalformedHeader, byte,
+                         "in the level table, " + levelName(static_cast<int>(l)) + ": " + detail);
+        };
+        const std::uint64_t cells = l * 3 < 63 ? std::uint64_t{1} << (3 * l) : UINT64_MAX;
+        if ((l == 0 && e.nodes != 1) || e.nodes > cells || e.leaves > e.nodes ||
+            e.points < e.nodes || e.nodes > info.totalNodes - nodes ||
+            e.points > info.totalPoints - points) {
+            throw bad("the counts (" + std::to_string(e.nodes) + " nodes, " +
+                      std::to_string(e.leaves) + " leaves, " + std::to_string(e.points) +
+                      " points) do not fit the header's totals and the octree");
+        }
+        const std::uint64_t expectedNodeOffset =
+            info.nodeTableOffset() + nodes * omh::kNodeRecordBytes;
+        if (e.nodeTableOffset != expectedNodeOffset) {
+            throw bad("expected the node table at byte " + std::to_string(expectedNodeOffset));
+        }
+        nodes += e.nodes;
+        points += e.points;
+    }
+    if (nodes != info.totalNodes || points != info.totalPoints) {
+        throw error(InputErrorKind::CountMismatch, omh::kHeaderBytes,
+                    "the level table sums to " + std::to_string(nodes) + " nodes and " +
+                        std::to_string(points) + " points, the header declares " +
+                        std::to_string(info.totalNodes) + " and " +
+                        std::to_string(info.totalPoints));
+    }
+    // The totals are bounded by the file size before any offset is computed from them.
+    const std::uint64_t fixed = info.nodeTableOffset() + omh::kFooterBytes;
+    if (fileBytes < fixed || info.totalNodes > (fileBytes - fixed) / omh::kNodeRecordBytes ||
+        info.totalPoints >
+            (fileBytes - fixed - info.totalNodes * omh::kNodeRecordBytes) / info.recordBytes) {
+        throw error(InputErrorKind::Truncated, fileBytes,
+                    "the file ends at byte " + std::to_string(fileBytes) + ", inside " +
+                        omhSectionAt(info, fileBytes) + "; the header declares " +
+                        std::to_string(info.totalNodes) + " nodes and " +
+                        std::to_string(info.totalPoints) + " point records of " +
+                        std::to_string(info.recordBytes) + " bytes");
+    }
+    std::uint64_t payloadOffset = info.payloadOffset();
+    for (std::size_t l = 0; l < levelCount; ++l) {
+        if (info.levels[l].payloadOffset != payloadOffset) {
+            throw error(InputErrorKind::MalformedHeader,
+                        omh::kHeaderBytes + l * omh::kLevelEntryBytes + omh::level::kPayloadOffset,
+                        "in the level table, " + levelName(static_cast<int>(l)) +
+                            ": expected the point records at byte " +
+                            std::to_string(payloadOffset));
+        }
+        payloadOffset += info.levels[l].points * info.recordBytes;
+    }
+    const std::uint64_t expectedBytes = info.footerOffset() + omh::kFooterBytes;
+    if (fileBytes != expectedBytes) {
+        throw error(InputErrorKind::CountMismatch, expectedBytes,
+                    "the file should end with its footer at byte " + std::to_string(expectedBytes) +
+                        ", but it has " + std::to_string(fileBytes - expectedBytes) +
+                        " more bytes");
+    }
+
+    // Footer.
+    std::array<std::uint8_t, omh::kFooterBytes> footer{};
+    const std::uint64_t footerStart = info.footerOffset();
+    m_stream.seek(footerStart);
+    m_stream.readExact(footer.data(), footer.size(), "the footer");
+    if (std::memcmp(footer.data(), omh::kFooterMagic.data(), omh::kFooterMagic.size()) != 0) {
+        throw error(InputErrorKind::MalformedValue, footerStart,
+                    "in the footer: expected the footer magic 'OMHEND\\x00\\x00'");
+    }
+    const auto storedFooterChecksum = loadLe<std::uint64_t>(footer.data() + omh::footer::kChecksum);
+    if (storedFooterChecksum != omh::smallChecksum(footer.data(), omh::footer::kChecksum)) {
+        throw error(InputErrorKind::MalformedValue, footerStart + omh::footer::kChecksum,
+                    "footer checksum mismatch: the footer is damaged");
+    }
+    if (loadLe<std::uint64_t>(footer.data() + omh::footer::kTotalNodes) != info.totalNodes ||
+        loadLe<std::uint64_t>(footer.data() + omh::footer::kTotalPoints) != info.totalPoints) {
+        throw error(InputErrorKind::CountMismatch, footerStart + omh::footer::kTotalNodes,
+                    "the footer's node and point counts differ from the header's");
+    }
+}
+
+void OmhReader::createHierarchy() {
+    std::call_once(m_created, [this] {
+        if (m_header.totalPoints > UINT32_MAX) {
+            throw InputError(InputErrorKind::UnsupportedFeature, m_header.path,
+                             InputLocation::byte(omh::header::kTotalPoints),
+                             "the file holds " + std::to_string(m_header.totalPoints) +
+                                 " point records; a loaded hierarchy indexes at most 2^32 - 1");
+        }
+        m_cloud = std::make_shared<SortedCloud>(
+            m_header.cube, m_header.sourceOffset, m_header.attributes,
+            static_cast<std::size_t>(m_header.totalPoints), CloudOrder::NodeOrder);
+        m_hierarchy =
+            std::make_shared<Hierarchy>(m_cloud, m_header.build.maxLevel, SplatSource::Stored);
+    });
+}
+
+std::shared_ptr<const Hierarchy> OmhReader::hierarchy() {
+    createHierarchy();
+    return m_hierarchy;
+}
+
+std::vector<OctreeNode> OmhReader::readNodes(int level, std::vector<std::uint8_t>& childMasks,
+                                             std::vector<morton::Code>& expectedCodes,
+                                             std::uint64_t firstPoint) {
+    const omh::LevelEntry& entry = m_header.levels[static_cast<std::size_t>(level)];
+    const std::string section = omhSectionAt(m_header, entry.nodeTableOffset);
+    m_block.resize(entry.nodes * omh::kNodeRecordBytes);
+    m_stream.seek(entry.nodeTableOffset);
+    m_stream.readExact(m_block.data(), m_block.size(), section);
+    const std::uint64_t checksum = checksumOf(m_block.data(), m_block.size());
+    if (checksum != entry.nodeChecksum) {
+        throw InputError(InputErrorKind::MalformedValue, m_header.path,
+                         InputLocation::byte(entry.nodeTableOffset),
+                         "checksum mismatch in " + section + ": the level table stores XXH3-64 " +
+                             hex(entry.nodeChecksum) + ", the records hash to " + hex(checksum));
+    }
+    // Level 0 is the root; every deeper level holds exactly the children its parents' masks
+    // announce, in Morton order (what the builder's arenas hold).
+    if (level == 0) {
+        expectedCodes.assign(1, morton::kRoot);
+    }
+    if (expectedCodes.size() != entry.nodes) {
+        throw InputError(InputErrorKind::CountMismatch, m_header.path,
+                         InputLocation::byte(entry.nodeTableOffset),
+                         "in " + section + ": the child masks of " + levelName(level - 1) +
+                             " announce " + std::to_string(expectedCodes.size()) +
+                             " nodes, the level table declares " + std::to_string(entry.nodes));
+    }
+    std::vector<OctreeNode> nodes(entry.nodes);
+    std::vector<morton::Code> nextCodes;
+    childMasks.assign(entry.nodes, 0);
+    std::uint64_t leaves = 0, points = 0;
+    std::uint32_t nextChild = 0;
+    for (std::size_t i = 0; i < entry.nodes; ++i) {
+        const std::uint8_t* record = m_block.data() + i * omh::kNodeRecordBytes;
+        const std::uint64_t byte = entry.nodeTableOffset + i * omh::kNodeRecordBytes;
+        const auto bad = [&](std::size_t field, const std::string& detail) {
+            return InputError(InputErrorKind::MalformedValue, m_header.path,
+                              InputLocation::byte(byte + field),
+                              "in " + section + ", node " + std::to_string(i) + ": " + detail);
+        };
+        OctreeNode& node = nodes[i];
+        node.code = loadLe<std::uint64_t>(record + omh::node::kCode);
+        if (node.code != expectedCodes[i]) {
+            throw bad(omh::node::kCode, "expected code " + hex(expectedCodes[i]) +
+                                            " (announced by its parent's child mask), found " +
+                                            hex(node.code));
+        }
+        const auto first = loadLe<std::uint64_t>(record + omh::node::kFirstPoint);
+        if (first != firstPoint + points) {
+            throw bad(omh::node::kFirstPoint, "expected its points to start at record " +
+                                                  std::to_string(firstPoint + points));
+        }
+        const auto count = loadLe<std::uint64_t>(record + omh::node::kPointCount);
+        if (count == 0 || count > entry.points - points) {
+            throw bad(omh::node::kPointCount, "expected 1 to " +
+                                                  std::to_string(entry.points - points) +
+                                                  " points, found " + std::to_string(count));
+        }
+        node.splatScale = loadLe<float>(record + omh::node::kSplatScale);
+        if (!std::isfinite(node.splatScale) || !(node.splatScale > 0.0f)) {
+            throw bad(omh::node::kSplatScale, "expected a finite splat scale > 0");
+        }
+        const std::uint8_t mask = record[omh::node::kChildMask];
+        node.flags = record[omh::node::kFlags];
+        if ((node.flags & ~omh::kKnownNodeFlags) != 0 || node.isLeaf() != (mask == 0) ||
+            (node.has(NodeFlag::Collapsed) &&
+             !(node.isLeaf() && level == m_header.build.maxLevel - 1)) ||
+            (level == m_header.build.maxLevel && !node.isLeaf())) {
+            throw bad(omh::node::kFlags, "flags " + std::to_string(node.flags) +
+                                             " and child mask " + std::to_string(mask) +
+                                             " contradict each other or the level");
+        }
+        if (loadLe<std::uint16_t>(record + omh::node::kReserved) != 0) {
+            throw bad(omh::node::kReserved, "expected reserved zero bytes");
+        }
+        node.sampleIndices = nullptr;
+        node.coveredBegin = static_cast<std::uint32_t>(firstPoint + points);
+        node.pointCount = static_cast<std::uint32_t>(count);
+        node.coveredCount = node.pointCount;
+        node.childCount = static_cast<std::uint8_t>(std::popcount(mask));
+        node.firstChild = node.childCount > 0 ? nextChild : 0; // a leaf's is 0, as built
+        nextChild += node.childCount;
+        childMasks[i] = mask;
+        for (unsigned octant = 0; octant < 8; ++octant) {
+            if ((mask & (1u << octant)) != 0) {
+                nextCodes.push_back(morton::child(node.code, octant));
+            }
+        }
+        leaves += node.isLeaf() ? 1 : 0;
+        points += count;
+    }
+    if (leaves != entry.leaves || points != entry.points) {
+        throw InputError(InputErrorKind::CountMismatch, m_header.path,
+                         InputLocation::byte(entry.nodeTableOffset),
+                         "in " + section + ": the nodes hold " + std::to_string(leaves) +
+                             " leaves and " + std::to_string(points) +
+                             " points, the level table declares " + std::to_string(entry.leaves) +
+                             " and " + std::to_string(entry.points));
+    }
+    expectedCodes = std::move(nextCodes);
+    return nodes;
+}
+
+void OmhReader::readPoints(int level, const std::vector<OctreeNode>& nodes,
+                           std::uint64_t firstPoint) {
+    const omh::LevelEntry& entry = m_header.levels[static_cast<std::size_t>(level)];
+    const std::string section = omhSectionAt(m_header, entry.payloadOffset);
+    const std::size_t recordBytes = m_layout.bytes;
+    const std::size_t blockRecords = std::max<std::size_t>(1, kBlockBytes / recordBytes);
+    SortedCloud& cloud = *m_cloud;
+    StoredSplats& splats = m_hierarchy->mutableStoredSplats();
+    const AttributeSet attributes = m_header.attributes;
+    const int shift = 3 * (morton::kMaxLevel - level);
+    oms::PayloadChecksum checksum;
+    // A point that breaks a rule is reported only after the checksum matched: in a damaged
+    // file the checksum mismatch is the better explanation.
+    std::optional<InputError> firstProblem;
+    std::size_t nodeIndex = 0;
+    std::uint64_t nodeEnd = nodes.empty() ? 0 : nodes[0].pointCount;
+    m_stream.seek(entry.payloadOffset);
+    for (std::uint64_t begin = 0; begin < entry.points;) {
+        const std::size_t count =
+            static_cast<std::size_t>(std::min<std::uint64_t>(blockRecords, entry.points - begin));
+        m_block.resize(count * recordBytes);
+        m_stream.readExact(m_block.data(), m_block.size(), section);
+        checksum.update(m_block.data(), m_block.size());
+        const std::uint8_t* record = m_block.data();
+        for (std::size_t r = 0; r < count; ++r, record += recordBytes) {
+            const std::uint64_t inLevel = begin + r;
+            while (inLevel >= nodeEnd) {
+                nodeEnd += nodes[++nodeIndex].pointCount;
+            }
+            const std::size_t point = static_cast<std::size_t>(firstPoint + inLevel);
+            const auto p = loadLe<glm::vec3>(record);
+            const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+            const morton::Code code = finite ? morton::encodeUnit(p.x, p.y, p.z) : 0;
+            if ((!finite || (code >> shift) != nodes[nodeIndex].code) && !firstProblem) {
+                firstProblem.emplace(
+                    InputErrorKind::MalformedValue, m_header.path,
+                    InputLocation::byte(entry.payloadOffset + inLevel * recordBytes),
+                    "in " + section + ", record " + std::to_string(inLevel) +
+                        ": the position lies outside the cell of its node " +
+                        hex(nodes[nodeIndex].code));
+            }
+            cloud.mutablePositions()[point] = p;
+            if (attributes.has(Attribute::Normal)) {
+                cloud.mutableNormals()[point] =
+                    loadLe<glm::vec3>(record + m_layout.point.normalOffset);
+            }
+            if (attributes.has(Attribute::Color)) {
+                cloud.mutableColors()[point] =
+                    loadLe<glm::u8vec3>(record + m_layout.point.colorOffset);
+            }
+            if (attributes.has(Attribute::Intensity)) {
+                cloud.mutableIntensities()[point] =
+                    loadLe<std::uint16_t>(record + m_layout.point.intensityOffset);
+            }
+            splats.setEncoded(point, loadLe<std::uint16_t>(record + m_layout.radiusOffset),
+                              m_header.estimatedNormals
+                                  ? loadLe<std::uint32_t>(record + m_layout.estimatedNormalOffset)
+                                  : 0u);
+        }
+        begin += count;
+    }
+    const std::uint64_t digest = checksum.digest();
+    if (digest != entry.payloadChecksum) {
+        throw InputError(InputErrorKind::MalformedValue, m_header.path,
+                         InputLocation::byte(entry.payloadOffset),
+                         "checksum mismatch in " + section + ": the level table stores XXH3-64 " +
+                             hex(entry.payloadChecksum) + ", the records hash to " + hex(digest));
+    }
+    if (firstProblem) {
+        throw *firstProblem;
+    }
+}
+
+void OmhReader::load(const LevelCallback& onLevel, const std::atomic<bool>* cancel) {
+    if (m_loadCalled) {
+        throw std::logic_error(m_header.path + ": OmhReader::load() called twice");
+    }
+    m_loadCalled = true;
+    createHierarchy();
+    // Complete before anything is published: every node that appears is final, so a front
+    // treats all of them as settled (Hierarchy::isSettled).
+    m_hierarchy->markComplete();
+    std::vector<std::uint8_t> childMasks;
+    std::vector<morton::Code> expectedCodes;
+    std::uint64_t firstPoint = 0;
+    for (int level = 0; level <= m_header.build.maxLevel; ++level) {
+        if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) {
+            return;
+        }
+        const std::vector<OctreeNode> nodes =
+            readNodes(level, childMasks, expectedCodes, firstPoint);
+        readPoints(level, nodes, firstPoint);
+        for (const OctreeNode& node : nodes) {
+            m_hierarchy->appendNode(level, node);
+        }
+        firstPoint += m_header.levels[static_cast<std::size_t>(level)].points;
+        m_cloud->publish(static_cast<std::size_t>(firstPoint));
+        m_hierarchy->publishNodes(level);
+        if (onLevel) {
+            onLevel(level);
+        }
+    }
+    if (!expectedCodes.empty()) {
+        throw InputError(InputErrorKind::MalformedValue, m_header.path,
+                         InputLocation::byte(m_header.levels.back().nodeTableOffset),
+                         "in the node table of the deepest level: nodes announce children below "
+                         "the hierarchy's depth");
+    }
+    m_cloud->markComplete();
+}
+
+void OmhReader::verify() {
+    const auto check = [&](std::uint64_t offset, std::uint64_t bytes, std::uint64_t expected) {
+        const std::string section = omhSectionAt(m_header, offset);
+        oms::PayloadChecksum checksum;
+        m_stream.seek(offset);
+        for (std::uint64_t done = 0; done < bytes;) {
+            const std::size_t take =
+                static_cast<std::size_t>(std::min<std::uint64_t>(kBlockBytes, bytes - done));
+            m_block.resize(take);
+            m_stream.readExact(m_block.data(), take, section);
+            checksum.update(m_block.data(), take);
+            done += take;
+        }
+        const std::uint64_t digest = checksum.digest();
+        if (digest != expected) {
+            throw InputError(InputErrorKind::MalformedValue, m_header.path,
+                             InputLocation::byte(offset),
+                             "checksum mismatch in " + section +
+                                 ": the level table stores "
+                                 "XXH3-64 " +
+                                 hex(expected) + ", the bytes hash to " + hex(digest));
+        }
+    };
+    // Header, level table and footer were verified at open.
+    for (const omh::LevelEntry& e : m_header.levels) {
+        check(e.nodeTableOffset, e.nodes * omh::kNodeRecordBytes, e.nodeChecksum);
+    }
+    for (const omh::LevelEntry& e : m_header.levels) {
+        check(e.payloadOffset, e.points * m_header.recordBytes, e.payloadChecksum);
+    }
+}
+
+} // namespace omicron

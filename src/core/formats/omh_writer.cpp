@@ -1,0 +1,246 @@
+#include "formats/omh_writer.hpp"
+
+#include "io/atomic_file_writer.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <vector>
+
+namespace omicron {
+
+namespace {
+
+// Point records are encoded into a block of about this size before being hashed and written.
+constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
+
+template <typename T> void store(std::uint8_t* at, const T& value) {
+    std::memcpy(at, &value, sizeof(T));
+}
+
+std::uint8_t childMask(const Hierarchy& hierarchy, int level, const OctreeNode& node) {
+    std::uint8_t mask = 0;
+    for (std::uint32_t c = 0; c < node.childCount; ++c) {
+        const OctreeNode& child = hierarchy.node(level + 1, node.firstChild + c);
+        mask = static_cast<std::uint8_t>(mask | (1u << (child.code & 7u)));
+    }
+    return mask;
+}
+
+// Encodes point records into blocks, hashing and writing each block when full.
+class RecordSink {
+public:
+    RecordSink(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::RecordLayout& layout)
+        : m_file(file), m_cloud(hierarchy.cloud()), m_layout(layout),
+          m_block(std::max<std::size_t>(1, kBlockBytes / layout.bytes) * layout.bytes) {}
+
+    // One held point of a node and its splat attributes (`estimatedNormal` only stored when
+    // the layout has room for it).
+    void add(std::uint32_t index, std::uint16_t encodedRadius, std::uint32_t estimatedNormal) {
+        if (m_used == m_block.size()) {
+            flush();
+        }
+        std::uint8_t* record = m_block.data() + m_used;
+        const AttributeSet attributes = m_cloud.attributes();
+        store(record, m_cloud.position(index));
+        if (attributes.has(Attribute::Normal)) {
+            store(record + m_layout.point.normalOffset, m_cloud.normals()[index]);
+        }
+        if (attributes.has(Attribute::Color)) {
+            store(record + m_layout.point.colorOffset, m_cloud.color(index));
+        }
+        if (attributes.has(Attribute::Intensity)) {
+            store(record + m_layout.point.intensityOffset, m_cloud.intensities()[index]);
+        }
+        store(record + m_layout.radiusOffset, encodedRadius);
+        if (m_layout.estimatedNormalOffset != 0) {
+            store(record + m_layout.estimatedNormalOffset, estimatedNormal);
+        }
+        m_used += m_layout.bytes;
+    }
+
+    // Writes what is pending and returns the checksum of everything since the last call.
+    std::uint64_t finishSection() {
+        flush();
+        const std::uint64_t digest = m_checksum->digest();
+        m_checksum = std::make_unique<oms::PayloadChecksum>();
+        return digest;
+    }
+
+private:
+    void flush() {
+        m_checksum->update(m_block.data(), m_used);
+        m_file.write(m_block.data(), m_used);
+        m_used = 0;
+    }
+
+    AtomicFileWriter& m_file;
+    const SortedCloud& m_cloud;
+    omh::RecordLayout m_layout;
+    std::vector<std::uint8_t> m_block;
+    std::size_t m_used = 0;
+    std::unique_ptr<oms::PayloadChecksum> m_checksum = std::make_unique<oms::PayloadChecksum>();
+};
+
+// The splat attributes of the nodes in file order, estimated a batch of nodes at a time in
+// parallel (the writer itself is sequential): a save pays for every node's estimate once.
+class NodeSplatBatches {
+public:
+    explicit NodeSplatBatches(const Hierarchy& hierarchy) : m_hierarchy(hierarchy) {}
+
+    // Nodes are asked for in order: level by level, each level from index 0.
+    const NodeSplats& of(int level, std::size_t index) {
+        if (level != m_level || index >= m_batchEnd) {
+            fill(level, index);
+        }
+        return m_batch[index - m_batchBegin];
+    }
+
+private:
+    void fill(int level, std::size_t begin) {
+        const std::size_t nodes = m_hierarchy.nodeCount(level);
+        // Batches of about kBatchPoints held points keep memory bounded.
+        std::size_t end = begin, points = 0;
+        while (end < nodes && (end == begin || points < kBatchPoints)) {
+            points += m_hierarchy.node(level, end).pointCount;
+            ++end;
+        }
+        m_level = level;
+        m_batchBegin = begin;
+        m_batchEnd = end;
+        m_batch.resize(end - begin);
+        tbb::parallel_for(begin, end, [&](std::size_t i) {
+            m_hierarchy.nodeSplats(m_hierarchy.node(level, i), m_batch[i - begin],
+                                   m_scratch.local());
+        });
+    }
+
+    static constexpr std::size_t kBatchPoints = std::size_t{1} << 20;
+    const Hierarchy& m_hierarchy;
+    tbb::enumerable_thread_specific<SplatScratch> m_scratch;
+    std::vector<NodeSplats> m_batch;
+    int m_level = -1;
+    std::size_t m_batchBegin = 0;
+    std::size_t m_batchEnd = 0;
+};
+
+} // namespace
+
+omh::BuildInfo omhBuildInfo(const BuildOptions& options, const BuildStatistics& statistics) {
+    omh::BuildInfo build;
+    build.maxLevel = options.maxLevel;
+    build.ratio = options.ratio;
+    build.collapse = options.collapse;
+    build.inputPoints = statistics.inputPoints;
+    build.droppedPoints = statistics.droppedPoints;
+    build.collapsedLeaves = statistics.collapsedLeaves;
+    return build;
+}
+
+void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::BuildInfo& build,
+              const OmhWriteOptions& options) {
+    const auto fail = [&](const std::string& what) {
+        throw OutputError(path + ": " + what);
+    };
+    if (!hierarchy.publishedCut().complete) {
+        fail("the hierarchy is not complete; only a finished build can be saved");
+    }
+    if (build.maxLevel != hierarchy.maxLevel()) {
+        fail("the build info says depth " + std::to_string(build.maxLevel) +
+             ", the hierarchy has depth " + std::to_string(hierarchy.maxLevel()));
+    }
+    const SortedCloud& cloud = hierarchy.cloud();
+    omh::Header header;
+    header.build = build;
+    header.attributes = cloud.attributes();
+    header.estimatedNormals = hierarchy.estimatesNormals();
+    const omh::RecordLayout layout =
+        omh::RecordLayout::of(header.attributes, header.estimatedNormals);
+    header.recordBytes = layout.bytes;
+    header.cube = cloud.cube();
+    header.sourceOffset = cloud.sourceOffset();
+    const int levels = hierarchy.maxLevel() + 1;
+    header.levels.resize(static_cast<std::size_t>(levels));
+    for (int level = 0; level < levels; ++level) {
+        omh::LevelEntry& entry = header.levels[static_cast<std::size_t>(level)];
+        entry.nodes = hierarchy.nodeCount(level);
+        for (std::size_t i = 0; i < entry.nodes; ++i) {
+            const OctreeNode& node = hierarchy.node(level, i);
+            entry.leaves += node.isLeaf() ? 1 : 0;
+            entry.points += node.pointCount;
+        }
+        header.totalNodes += entry.nodes;
+        header.totalPoints += entry.points;
+    }
+    if (header.levels[0].nodes != 1) {
+        fail("the hierarchy has " + std::to_string(header.levels[0].nodes) +
+             " nodes at level 0, expected the root alone");
+    }
+    std::uint64_t nodeOffset = header.nodeTableOffset();
+    std::uint64_t payloadOffset = header.payloadOffset();
+    for (omh::LevelEntry& entry : header.levels) {
+        entry.nodeTableOffset = nodeOffset;
+        entry.payloadOffset = payloadOffset;
+        nodeOffset += entry.nodes * omh::kNodeRecordBytes;
+        payloadOffset += entry.points * layout.bytes;
+    }
+
+    AtomicFileWriter file(path);
+    const auto headerBytes = omh::encodeHeader(header);
+    file.write(headerBytes.data(), headerBytes.size());
+    // The level table holds the sections' checksums, known once they are written: it is
+    // written now as a placeholder and overwritten before the file is renamed into place.
+    const std::vector<std::uint8_t> placeholder(omh::encodeLevelTable(header.levels).size(), 0);
+    file.write(placeholder.data(), placeholder.size());
+
+    std::vector<std::uint8_t> records;
+    std::uint64_t firstPoint = 0;
+    for (int level = 0; level < levels; ++level) {
+        omh::LevelEntry& entry = header.levels[static_cast<std::size_t>(level)];
+        records.assign(entry.nodes * omh::kNodeRecordBytes, 0);
+        for (std::size_t i = 0; i < entry.nodes; ++i) {
+            const OctreeNode& node = hierarchy.node(level, i);
+            std::uint8_t* record = records.data() + i * omh::kNodeRecordBytes;
+            store(record + omh::node::kCode, node.code);
+            store(record + omh::node::kFirstPoint, firstPoint);
+            store(record + omh::node::kPointCount, std::uint64_t{node.pointCount});
+            store(record + omh::node::kSplatScale, node.splatScale);
+            store(record + omh::node::kChildMask, childMask(hierarchy, level, node));
+            store(record + omh::node::kFlags, node.flags);
+            firstPoint += node.pointCount;
+        }
+        entry.nodeChecksum = [&] {
+            oms::PayloadChecksum checksum;
+            checksum.update(records.data(), records.size());
+            return checksum.digest();
+        }();
+        file.write(records.data(), records.size());
+    }
+
+    RecordSink sink(file, hierarchy, layout);
+    NodeSplatBatches splats(hierarchy);
+    for (int level = 0; level < levels; ++level) {
+        omh::LevelEntry& entry = header.levels[static_cast<std::size_t>(level)];
+        for (std::size_t i = 0; i < entry.nodes; ++i) {
+            const OctreeNode& node = hierarchy.node(level, i);
+            const NodeSplats& nodeSplats = splats.of(level, i);
+            for (std::uint32_t p = 0; p < node.pointCount; ++p) {
+                sink.add(node.heldPoint(p), nodeSplats.radii[p],
+                         nodeSplats.normals.empty() ? 0u : nodeSplats.normals[p]);
+            }
+        }
+        entry.payloadChecksum = sink.finishSection();
+        if (options.afterLevel) {
+            options.afterLevel(level);
+        }
+    }
+
+    const auto footerBytes = omh::encodeFooter(header.totalNodes, header.totalPoints);
+    file.write(footerBytes.data(), footerBytes.size());
+    const std::vector<std::uint8_t> levelTable = omh::encodeLevelTable(header.levels);
+    file.writeAt(header.levelTableOffset(), levelTable.data(), levelTable.size());
+    file.commit();
+}
+
+} // namespace omicron

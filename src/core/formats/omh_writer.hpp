@@ -1,0 +1,33 @@
+// Saves a finished hierarchy as a .omh file (layout in omh_format.hpp, docs/FORMATS.md),
+// atomically: the target is either the complete new file or left as it was.
+#pragma once
+
+#include "build/build_options.hpp"
+#include "build/build_statistics.hpp"
+#include "build/hierarchy.hpp"
+#include "formats/omh_format.hpp"
+#include "io/atomic_file_writer.hpp"
+
+#include <functional>
+#include <string>
+
+namespace omicron {
+
+struct OmhWriteOptions {
+    // Called after each level's point records were handed to the file (level 0 first). For
+    // progress, and for the test that kills a save half-way (see omicron-cli build --save).
+    std::function<void(int level)> afterLevel;
+};
+
+// The header fields a build determines: its parameters and counts.
+omh::BuildInfo omhBuildInfo(const BuildOptions& options, const BuildStatistics& statistics);
+
+// Writes every published node of the complete `hierarchy` (built, or loaded from a .omh file)
+// with the points each holds: position, the cloud's normal/colour/intensity, the splat radius
+// and estimated normal. Loading the file and saving it again gives the same bytes. Throws
+// OutputError naming the file (an incomplete hierarchy, build info that disagrees with it,
+// I/O errors such as a full disk); the temporary file is removed and the target untouched.
+void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::BuildInfo& build,
+              const OmhWriteOptions& options = {});
+
+} // namespace omicron

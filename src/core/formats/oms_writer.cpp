@@ -1,0 +1,160 @@
+#include "formats/oms_writer.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+
+namespace omicron {
+
+namespace {
+
+// Records are encoded into a block of about this size before being hashed and written.
+constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
+
+template <typename T> void store(std::uint8_t* at, const T& value) {
+    std::memcpy(at, &value, sizeof(T));
+}
+
+bool isFinite(const glm::dvec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+std::array<std::uint8_t, oms::kHeaderBytes> encodeHeader(const CubeTransform& cube,
+                                                         const glm::dvec3& sourceOffset,
+                                                         AttributeSet attributes,
+                                                         std::uint64_t pointCount) {
+    namespace h = oms::header;
+    std::array<std::uint8_t, oms::kHeaderBytes> bytes{}; // reserved fields stay zero
+    std::memcpy(bytes.data() + h::kMagic, oms::kMagic.data(), oms::kMagic.size());
+    store(bytes.data() + h::kVersion, oms::kVersion);
+    store(bytes.data() + h::kEndianness, oms::kEndiannessMarker);
+    store(bytes.data() + h::kPointCount, pointCount);
+    store(bytes.data() + h::kSortDepth, oms::kSortDepth);
+    store(bytes.data() + h::kAttributes, attributes.bits());
+    store(bytes.data() + h::kRecordBytes,
+          static_cast<std::uint16_t>(oms::RecordLayout::of(attributes).bytes));
+    for (int axis = 0; axis < 3; ++axis) {
+        store(bytes.data() + h::kCubeOrigin + 8 * axis, cube.origin[axis]);
+        store(bytes.data() + h::kSourceOffset + 8 * axis, sourceOffset[axis]);
+    }
+    store(bytes.data() + h::kCubeEdge, cube.edge);
+    store(bytes.data() + h::kChecksum, oms::headerChecksum(bytes.data()));
+    return bytes;
+}
+
+} // namespace
+
+OmsWriter::~OmsWriter() = default;
+
+void OmsWriter::fail(const std::string& what) {
+    // Dropping the file removes the temporary; the target stays as it was.
+    m_file.reset();
+    throw OutputError(m_path + ": " + what);
+}
+
+void OmsWriter::open(const std::string& path, const CubeTransform& cube,
+                     const glm::dvec3& sourceOffset, AttributeSet attributes,
+                     std::uint64_t pointCount) {
+    m_path = path;
+    m_file.reset();
+    if (pointCount == 0) {
+        fail("a .oms file holds at least one point, got 0");
+    }
+    if ((attributes.bits() & ~oms::kKnownAttributeBits) != 0) {
+        fail("unknown attribute bits " + std::to_string(attributes.bits()));
+    }
+    if (!isFinite(cube.origin) || !isFinite(sourceOffset) || !std::isfinite(cube.edge) ||
+        !(cube.edge > 0.0)) {
+        fail("the cube origin, cube edge and source offset must be finite and the edge > 0");
+    }
+    m_file = std::make_unique<AtomicFileWriter>(path);
+    m_checksum = std::make_unique<oms::PayloadChecksum>();
+    m_layout = oms::RecordLayout::of(attributes);
+    m_attributes = attributes;
+    m_pointCount = pointCount;
+    m_pointsWritten = 0;
+    m_lastCode = 0;
+    const auto header = encodeHeader(cube, sourceOffset, attributes, pointCount);
+    m_file->write(header.data(), header.size());
+}
+
+void OmsWriter::append(const SortedCloud& cloud, std::size_t begin, std::size_t end) {
+    if (!m_file) {
+        throw OutputError(m_path + ": OmsWriter::append() without a successful open()");
+    }
+    if (cloud.attributes() != m_attributes) {
+        fail("the appended cloud has attribute bits " + std::to_string(cloud.attributes().bits()) +
+             ", the file was opened with " + std::to_string(m_attributes.bits()));
+    }
+    if (begin != m_pointsWritten || end < begin || end > cloud.sortedEnd()) {
+        fail("expected a published range starting at point " + std::to_string(m_pointsWritten) +
+             ", got [" + std::to_string(begin) + ", " + std::to_string(end) + ") with " +
+             std::to_string(cloud.sortedEnd()) + " points published");
+    }
+    if (end - begin > m_pointCount - m_pointsWritten) {
+        fail("appending [" + std::to_string(begin) + ", " + std::to_string(end) + ") exceeds the " +
+             std::to_string(m_pointCount) + " points declared at open()");
+    }
+    const auto normals = cloud.normals();
+    const auto intensities = cloud.intensities();
+    const std::size_t recordBytes = m_layout.bytes;
+    const std::size_t recordsPerBlock = std::max<std::size_t>(1, kBlockBytes / recordBytes);
+    for (std::size_t blockBegin = begin; blockBegin < end;) {
+        const std::size_t blockEnd = std::min(end, blockBegin + recordsPerBlock);
+        m_block.resize((blockEnd - blockBegin) * recordBytes);
+        std::uint8_t* record = m_block.data();
+        for (std::size_t i = blockBegin; i < blockEnd; ++i, record += recordBytes) {
+            const glm::vec3 p = cloud.position(i);
+            // The reader recomputes codes from the stored positions, so that is what must be
+            // in order (SortedCloud::code does the same).
+            const morton::Code code = morton::encodeUnit(p.x, p.y, p.z);
+            if (code < m_lastCode) {
+                fail("point " + std::to_string(i) +
+                     " is out of Morton order: the cloud is not sorted");
+            }
+            m_lastCode = code;
+            store(record, p);
+            if (m_attributes.has(Attribute::Normal)) {
+                store(record + m_layout.normalOffset, normals[i]);
+            }
+            if (m_attributes.has(Attribute::Color)) {
+                store(record + m_layout.colorOffset, cloud.color(i));
+            }
+            if (m_attributes.has(Attribute::Intensity)) {
+                store(record + m_layout.intensityOffset, intensities[i]);
+            }
+        }
+        m_checksum->update(m_block.data(), m_block.size());
+        m_file->write(m_block.data(), m_block.size());
+        blockBegin = blockEnd;
+    }
+    m_pointsWritten = end;
+}
+
+void OmsWriter::finish() {
+    if (!m_file) {
+        throw OutputError(m_path + ": OmsWriter::finish() without a successful open()");
+    }
+    if (m_pointsWritten != m_pointCount) {
+        fail("finish() after " + std::to_string(m_pointsWritten) + " points, expected the " +
+             std::to_string(m_pointCount) + " declared at open()");
+    }
+    namespace f = oms::footer;
+    std::array<std::uint8_t, oms::kFooterBytes> footer{};
+    std::memcpy(footer.data() + f::kMagic, oms::kFooterMagic.data(), oms::kFooterMagic.size());
+    store(footer.data() + f::kPointCount, m_pointCount);
+    store(footer.data() + f::kChecksum, m_checksum->digest());
+    m_file->write(footer.data(), footer.size());
+    m_file->commit();
+    m_file.reset();
+}
+
+void writeOms(const std::string& path, const SortedCloud& cloud, std::size_t pointCount) {
+    OmsWriter writer;
+    writer.open(path, cloud.cube(), cloud.sourceOffset(), cloud.attributes(), pointCount);
+    writer.append(cloud, 0, pointCount);
+    writer.finish();
+}
+
+} // namespace omicron

@@ -1,0 +1,126 @@
+#include "io/atomic_file_writer.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+
+namespace omicron {
+
+namespace {
+constexpr std::size_t kBufferBytes = 4 << 20;
+}
+
+AtomicFileWriter::AtomicFileWriter(std::string targetPath)
+    : m_targetPath(std::move(targetPath)), m_buffer(kBufferBytes) {
+    const std::filesystem::path target(m_targetPath);
+    if (std::filesystem::is_directory(target)) {
+        throw OutputError(m_targetPath + ": is a directory, expected a file name to write");
+    }
+    const std::filesystem::path folder =
+        target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+    std::string tempName = target.filename().string();
+    tempName.insert(0, 1, '.');
+    tempName.append(".tmp-XXXXXX");
+    std::string pattern = (folder / tempName).string();
+    m_fd = ::mkstemp(pattern.data());
+    if (m_fd < 0) {
+        throw OutputError(m_targetPath + ": cannot create a temporary file in " +
+                          folder.string() + ": " + std::strerror(errno));
+    }
+    m_tempPath = pattern;
+    // mkstemp creates 0600; a replaced file keeps its mode, a new one gets the usual 0644.
+    struct stat existing {};
+    const mode_t mode = ::stat(m_targetPath.c_str(), &existing) == 0 ? (existing.st_mode & 07777)
+                                                                      : mode_t{0644};
+    ::fchmod(m_fd, mode);
+}
+
+AtomicFileWriter::~AtomicFileWriter() {
+    if (m_fd >= 0) {
+        ::close(m_fd);
+    }
+    if (!m_committed && !m_tempPath.empty()) {
+        ::unlink(m_tempPath.c_str());
+    }
+}
+
+void AtomicFileWriter::fail(const std::string& what, int error) {
+    throw OutputError(m_targetPath + ": " + what + ": " + std::strerror(error));
+}
+
+void AtomicFileWriter::flushBuffer() {
+    std::size_t done = 0;
+    while (done < m_buffered) {
+        const ssize_t wrote = ::write(m_fd, m_buffer.data() + done, m_buffered - done);
+        if (wrote < 0) {
+            if (errno == EINTR) {
+                continue;
+            }
+            fail("write failed", errno);
+        }
+        done += static_cast<std::size_t>(wrote);
+    }
+    m_buffered = 0;
+}
+
+void AtomicFileWriter::write(const void* data, std::size_t count) {
+    const auto* bytes = static_cast<const char*>(data);
+    m_bytesWritten += count;
+    while (count > 0) {
+        const std::size_t room = m_buffer.size() - m_buffered;
+        const std::size_t take = count < room ? count : room;
+        std::memcpy(m_buffer.data() + m_buffered, bytes, take);
+        m_buffered += take;
+        bytes += take;
+        count -= take;
+        if (m_buffered == m_buffer.size()) {
+            flushBuffer();
+        }
+    }
+}
+
+void AtomicFileWriter::writeAt(std::uint64_t offset, const void* data, std::size_t count) {
+    if (offset > m_bytesWritten || count > m_bytesWritten - offset) {
+        throw OutputError(m_targetPath + ": writeAt(" + std::to_string(offset) + ", " +
+                          std::to_string(count) + " bytes) beyond the " +
+                          std::to_string(m_bytesWritten) + " bytes written");
+    }
+    flushBuffer();
+    const auto* bytes = static_cast<const char*>(data);
+    while (count > 0) {
+        const ssize_t wrote = ::pwrite(m_fd, bytes, count, static_cast<off_t>(offset));
+        if (wrote < 0) {
+            if (errno == EINTR) {
+                continue;
+            }
+            fail("write failed", errno);
+        }
+        bytes += wrote;
+        count -= static_cast<std::size_t>(wrote);
+        offset += static_cast<std::uint64_t>(wrote);
+    }
+}
+
+void AtomicFileWriter::commit() {
+    flushBuffer();
+    if (::fsync(m_fd) != 0) {
+        fail("fsync failed", errno);
+    }
+    if (::close(m_fd) != 0) {
+        m_fd = -1;
+        fail("close failed", errno);
+    }
+    m_fd = -1;
+    if (std::rename(m_tempPath.c_str(), m_targetPath.c_str()) != 0) {
+        fail("cannot rename the finished temporary file onto it", errno);
+    }
+    m_committed = true;
+}
+
+} // namespace omicron

@@ -1,0 +1,57 @@
+#include "io/cloud_export.hpp"
+
+#include "io/atomic_file_writer.hpp"
+#include "io/las/las_writer.hpp"
+#include "io/ply/ply_writer.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+
+namespace omicron {
+
+namespace {
+
+std::string lowerExtension(const std::string& path) {
+    const auto dot = path.find_last_of('.');
+    const auto slash = path.find_last_of('/');
+    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) {
+        return {};
+    }
+    std::string extension = path.substr(dot);
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return extension;
+}
+
+} // namespace
+
+void exportCloudPoints(const std::string& path, const SortedCloud& cloud) {
+    const std::string extension = lowerExtension(path);
+    if (extension != ".ply" && extension != ".las") {
+        throw OutputError(path + ": cannot export points: expected a .ply or .las file name");
+    }
+    if (cloud.sortedEnd() == 0) {
+        throw OutputError(path + ": cannot export points: the cloud holds no sorted points");
+    }
+    PointBatch points;
+    cloud.copyRange(0, cloud.sortedEnd(), points);
+    if (extension == ".ply") {
+        PlyWriteOptions options;
+        options.offset = plyStorageOffset(cloud.cube(), cloud.sourceOffset());
+        options.comments.push_back("exported by omicron (points in Morton order)");
+        writePly(path, points, cloud.cube(), options);
+        return;
+    }
+    LasWriteOptions options;
+    options.pointFormat = cloud.attributes().has(Attribute::Color) ? 2 : 0;
+    // Integers relative to the cube's corner, with the finest power-of-ten step that keeps the
+    // largest coordinate (the cube's edge) below 10^9 < 2^31: sub-millimetre for a building,
+    // still exact enough for a 10 cm statue.
+    options.offset = cloud.cube().origin;
+    const double step = std::pow(10.0, std::ceil(std::log10(cloud.cube().edge / 1e9)));
+    options.scale = glm::dvec3(step);
+    writeLas(path, points, cloud.cube(), options);
+}
+
+} // namespace omicron

@@ -1,0 +1,16 @@
+// Writing a kept SortedCloud back out as an ordinary cloud file (the desktop application's
+// File -> Export Points): PLY or LAS chosen by the file name, points in Morton order.
+#pragma once
+
+#include "points/sorted_cloud.hpp"
+
+#include <string>
+
+namespace omicron {
+
+// Writes points [0, cloud.sortedEnd()) to `path`: binary PLY for ".ply", LAS 1.2 point format
+// 2 or 0 (with or without colour) for ".las" (any case); coordinates in source units. Throws
+// OutputError naming the file for another extension, an empty cloud or an I/O failure.
+void exportCloudPoints(const std::string& path, const SortedCloud& cloud);
+
+} // namespace omicron

@@ -1,0 +1,248 @@
+#include "io/las/las_reader.hpp"
+
+#include "io/file_stream.hpp"
+#include "io/input_error.hpp"
+#include "io/las/las_header.hpp"
+#include "io/pre_pass_monitor.hpp"
+#include "io/source_normalizer.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+static_assert(std::endian::native == std::endian::little,
+              "LAS records are little-endian and are decoded with memcpy loads");
+
+namespace omicron {
+
+namespace {
+
+// Records are read in blocks of whole records of about this size.
+constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
+
+// How many records, spread evenly over the file, decide the colour depth.
+constexpr std::uint64_t kColorSampleRecords = 4096;
+
+template <typename T> T load(const std::uint8_t* bytes) {
+    T value;
+    std::memcpy(&value, bytes, sizeof value);
+    return value;
+}
+
+// LAS stores colour in 16-bit fields, but many writers put 8-bit values there unscaled.
+enum class ColorDepth {
+    None,
+    EightBitIn16BitFields, // every sampled channel <= 255: taken as is
+    SixteenBit,            // some sampled channel > 255: scaled by 1/257, rounded
+};
+
+class LasReader final : public PointReader {
+public:
+    LasReader(const std::string& path, const OpenOptions& options)
+        : m_stream(path), m_header(las::readHeader(m_stream)) {
+        m_info.path = path;
+        m_info.format = CloudFormat::Las;
+        m_info.pointCount = m_header.pointCount;
+        m_info.sourceOffset = m_header.offset;
+        m_info.attributes.add(Attribute::Intensity);
+        if (las::formatHasColor(m_header.pointFormat)) {
+            m_info.attributes.add(Attribute::Color);
+            m_colorOffset = las::colorOffset(m_header.pointFormat);
+            m_colorDepth = sampleColorDepth();
+        }
+        if (options.knownBounds) {
+            m_info.sourceBounds = *options.knownBounds;
+        } else if (m_header.hasUsableBounds()) {
+            m_info.sourceBounds = m_header.declaredBounds;
+            m_info.boundsFromHeader = true;
+        } else {
+            m_info.sourceBounds = boundsPrePass(options);
+        }
+        m_info.cube = CubeTransform::fromBounds(m_info.sourceBounds);
+        m_info.formatDetail = describeFormat();
+    }
+
+    ReadSummary read(const BatchConsumer& consumer, const ReadOptions& options) override;
+
+private:
+    glm::dvec3 sourcePosition(const std::uint8_t* record) const {
+        return glm::dvec3(load<std::int32_t>(record), load<std::int32_t>(record + 4),
+                          load<std::int32_t>(record + 8)) *
+                   m_header.scale +
+               m_header.offset;
+    }
+
+    glm::u8vec3 color(const std::uint8_t* record) const {
+        const std::uint8_t* rgb = record + m_colorOffset;
+        const int red = load<std::uint16_t>(rgb);
+        const int green = load<std::uint16_t>(rgb + 2);
+        const int blue = load<std::uint16_t>(rgb + 4);
+        if (m_colorDepth == ColorDepth::SixteenBit) {
+            return {(red + 128) / 257, (green + 128) / 257, (blue + 128) / 257};
+        }
+        // A channel above 255 that the sample missed is clamped rather than wrapped.
+        return {std::min(red, 255), std::min(green, 255), std::min(blue, 255)};
+    }
+
+    // Calls visit(records, count, firstIndex) for consecutive blocks of whole records, in
+    // file order, until visit returns false.
+    template <typename Visit> void forEachBlock(Visit&& visit) {
+        const std::uint64_t stride = m_header.recordLength;
+        const std::uint64_t recordsPerBlock = std::max<std::uint64_t>(1, kBlockBytes / stride);
+        m_block.resize(static_cast<std::size_t>(recordsPerBlock * stride));
+        m_stream.seek(m_header.pointDataOffset);
+        for (std::uint64_t first = 0; first < m_header.pointCount; first += recordsPerBlock) {
+            const std::uint64_t count = std::min(recordsPerBlock, m_header.pointCount - first);
+            m_stream.readExact(m_block.data(), static_cast<std::size_t>(count * stride),
+                               "point records " + std::to_string(first) + " to " +
+                                   std::to_string(first + count - 1) + " (counting from 0, " +
+                                   std::to_string(stride) + " bytes each)");
+            if (!visit(m_block.data(), count, first)) {
+                return;
+            }
+        }
+    }
+
+    // Only when the header's bounds are unusable (NaN, min > max): one pass over the records.
+    Bounds boundsPrePass(const OpenOptions& options) {
+        Bounds bounds;
+        PrePassMonitor monitor(options, m_stream.path(), m_stream.size());
+        monitor.advance(m_header.pointDataOffset);
+        forEachBlock([&](const std::uint8_t* records, std::uint64_t count, std::uint64_t first) {
+            for (std::uint64_t i = 0; i < count; ++i) {
+                bounds.extend(sourcePosition(records + i * m_header.recordLength));
+            }
+            return monitor.reached(m_header.recordOffset(first + count));
+        });
+        monitor.finish();
+        return bounds;
+    }
+
+    // The heuristic: read the colour of up to kColorSampleRecords records spread evenly over
+    // the file; if every sampled channel is <= 255 the file holds 8-bit values in its 16-bit
+    // fields, otherwise true 16-bit values. A sample keeps opening cheap on huge files.
+    ColorDepth sampleColorDepth() {
+        const std::uint64_t samples = std::min(kColorSampleRecords, m_header.pointCount);
+        std::uint8_t rgb[6];
+        for (std::uint64_t s = 0; s < samples; ++s) {
+            const std::uint64_t index = s * m_header.pointCount / samples;
+            m_stream.seek(m_header.recordOffset(index) + m_colorOffset);
+            m_stream.readExact(rgb, sizeof rgb,
+                               "the colour of point record " + std::to_string(index));
+            for (int channel = 0; channel < 3; ++channel) {
+                if (load<std::uint16_t>(rgb + 2 * channel) > 255) {
+                    return ColorDepth::SixteenBit;
+                }
+            }
+        }
+        return ColorDepth::EightBitIn16BitFields;
+    }
+
+    std::string describeFormat() const {
+        std::string detail = "LAS 1." + std::to_string(m_header.versionMinor) + ", point format " +
+                             std::to_string(m_header.pointFormat) + ", " +
+                             std::to_string(m_header.recordLength) + "-byte records";
+        const int extraBytes =
+            m_header.recordLength - las::minimumRecordLength(m_header.pointFormat);
+        if (extraBytes > 0) {
+            detail += " (" + std::to_string(extraBytes) + " extra bytes)";
+        }
+        const std::string sampled =
+            " (judged from " + std::to_string(std::min(kColorSampleRecords, m_header.pointCount)) +
+            " sampled records)";
+        if (m_colorDepth == ColorDepth::EightBitIn16BitFields) {
+            detail += ", 8-bit colour in 16-bit fields" + sampled;
+        } else if (m_colorDepth == ColorDepth::SixteenBit) {
+            detail += ", 16-bit colour scaled to 8 bits" + sampled;
+        }
+        return detail;
+    }
+
+    [[noreturn]] void throwOutOfBounds(const SourceNormalizer& normalizer, std::uint64_t index,
+                                       const glm::dvec3& source) const {
+        const InputLocation where = InputLocation::byte(m_header.recordOffset(index));
+        try {
+            normalizer.throwOutOfBounds(m_info.path, where, source);
+        } catch (const InputError& error) {
+            throw InputError(error.kind(), m_info.path, where,
+                             "point record " + std::to_string(index) +
+                                 " (counting from 0): " + error.detail());
+        }
+    }
+
+    FileStream m_stream;
+    las::Header m_header;
+    ColorDepth m_colorDepth = ColorDepth::None;
+    std::size_t m_colorOffset = 0;
+    std::vector<std::uint8_t> m_block;
+};
+
+ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& options) {
+    ReadSummary summary;
+    const auto cancelled = [&] {
+        return options.cancel != nullptr && options.cancel->load();
+    };
+    if (cancelled()) {
+        summary.cancelled = true;
+        return summary;
+    }
+    const std::size_t batchPoints = std::max<std::size_t>(1, options.batchPoints);
+    PointBatch batch;
+    batch.attributes = m_info.attributes;
+    batch.reserve(
+        static_cast<std::size_t>(std::min<std::uint64_t>(batchPoints, m_header.pointCount)));
+
+    // Half a quantisation step: header bounds written from rounded coordinates may miss a
+    // point by that much. Points within it are clamped so batches stay inside the cube.
+    const glm::dvec3 steps = glm::abs(m_header.scale);
+    const double tolerance = 0.5 * std::max({steps.x, steps.y, steps.z});
+    const SourceNormalizer normalizer(m_info.cube, m_info.sourceBounds, tolerance);
+    const Bounds& bounds = m_info.sourceBounds;
+    const bool hasColor = m_colorDepth != ColorDepth::None;
+    const std::size_t stride = m_header.recordLength;
+
+    const auto deliver = [&] {
+        consumer(batch);
+        ++summary.batches;
+        summary.pointsDelivered += batch.size();
+        batch.clear();
+    };
+    forEachBlock([&](const std::uint8_t* records, std::uint64_t count, std::uint64_t first) {
+        for (std::uint64_t i = 0; i < count; ++i) {
+            const std::uint8_t* record = records + i * stride;
+            const glm::dvec3 source = sourcePosition(record);
+            if (!normalizer.inBounds(source)) {
+                throwOutOfBounds(normalizer, first + i, source);
+            }
+            batch.positions.push_back(
+                normalizer.toUnit(glm::clamp(source, bounds.min, bounds.max)));
+            batch.intensities.push_back(load<std::uint16_t>(record + las::kRecordIntensity));
+            if (hasColor) {
+                batch.colors.push_back(color(record));
+            }
+            if (batch.size() == batchPoints) {
+                deliver();
+                const bool morePoints = first + i + 1 < m_header.pointCount;
+                if (morePoints && cancelled()) {
+                    summary.cancelled = true;
+                    return false;
+                }
+            }
+        }
+        return true;
+    });
+    if (!batch.empty()) {
+        deliver();
+    }
+    return summary;
+}
+
+} // namespace
+
+std::unique_ptr<PointReader> openLasReader(const std::string& path, const OpenOptions& options) {
+    return std::make_unique<LasReader>(path, options);
+}
+
+} // namespace omicron

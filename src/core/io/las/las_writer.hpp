@@ -1,0 +1,44 @@
+// Writes a point batch as uncompressed LAS 1.2 or 1.4, atomically.
+#pragma once
+
+#include "io/atomic_file_writer.hpp"
+#include "points/cube_transform.hpp"
+#include "points/point_batch.hpp"
+
+#include <cstdint>
+#include <glm/vec3.hpp>
+#include <string>
+#include <vector>
+
+namespace omicron {
+
+// A variable length record written between the header and the points.
+struct LasVariableLengthRecord {
+    std::string userId; // at most 16 characters
+    std::uint16_t recordId = 0;
+    std::string description;           // at most 32 characters
+    std::vector<std::uint8_t> payload; // at most 65535 bytes
+};
+
+struct LasWriteOptions {
+    std::uint8_t versionMinor = 2; // 2 (LAS 1.2: point formats 0 to 5) or 4 (LAS 1.4: 0 to 10)
+    std::uint8_t pointFormat = 3;
+    // Stored integers are round((source - offset) / scale); every one must fit in int32, so
+    // georeferenced clouds need an offset near the data (e.g. CloudInfo::sourceOffset).
+    glm::dvec3 scale{0.001}; // source units per step; finite and > 0
+    glm::dvec3 offset{0.0};
+    std::uint16_t extraBytesPerRecord = 0; // zeros after each record's standard fields
+    std::vector<LasVariableLengthRecord> vlrs;
+};
+
+// Writes every point of `points` (positions mapped back to source units with `cube`). The
+// header's bounds are those of the quantised coordinates, so a reader's check against them is
+// exact. Intensity and colour are written when the format has the field: 8-bit colour as
+// value x 257 in the 16-bit fields (so 255 becomes 65535), an absent attribute as 0; an
+// attribute the format lacks is dropped. Each point is a single first return, unclassified.
+// Throws OutputError (bad options, a coordinate that does not fit in int32, an I/O error);
+// the target is untouched on failure.
+void writeLas(const std::string& path, const PointBatch& points, const CubeTransform& cube,
+              const LasWriteOptions& options = {});
+
+} // namespace omicron

@@ -1,0 +1,80 @@
+// Hot loops for the common binary PLY layout: native-endian float x y z, optionally float
+// normals and uchar colours, no lists. Both loops do only loads, a few compares and the
+// SourceNormalizer arithmetic, with an SSE2 path when x y z are adjacent; everything unusual
+// (non-finite points, points at or outside the bounds) is left to the caller's exact code.
+#pragma once
+
+#include "io/source_normalizer.hpp"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <glm/gtc/type_precision.hpp>
+#include <limits>
+
+namespace omicron {
+
+// Readable bytes every record buffer must have past its last record: the SIMD loads read a
+// 16-byte vector starting at x.
+constexpr std::size_t kFloatRecordPadding = 16;
+
+struct FloatRecordLayout {
+    std::size_t recordBytes = 0;
+    std::array<std::size_t, 3> position{}; // byte offsets of x y z (float)
+    bool hasNormals = false;
+    std::array<std::size_t, 3> normal{}; // float
+    bool hasColors = false;
+    std::array<std::size_t, 3> color{}; // uchar
+
+    bool adjacentPosition() const {
+        return position[1] == position[0] + 4 && position[2] == position[0] + 8;
+    }
+};
+
+// Min/max of the finite stored positions seen so far.
+struct FloatBox {
+    std::array<float, 3> low{std::numeric_limits<float>::infinity(),
+                             std::numeric_limits<float>::infinity(),
+                             std::numeric_limits<float>::infinity()};
+    std::array<float, 3> high{-std::numeric_limits<float>::infinity(),
+                              -std::numeric_limits<float>::infinity(),
+                              -std::numeric_limits<float>::infinity()};
+    std::uint64_t finite = 0;
+};
+
+// Extends `box` by the finite positions of `count` records; records with a NaN or infinite
+// coordinate are left out (the caller counts them as count - finite).
+void extendFloatBox(const std::uint8_t* records, std::size_t count, const FloatRecordLayout& layout,
+                    FloatBox& box);
+
+// What the conversion loop needs: SourceNormalizer's arithmetic, and a box of stored floats
+// inside which every point certainly passes SourceNormalizer::inBounds.
+struct FloatUnitTransform {
+    glm::dvec3 offset{0.0};
+    glm::dvec3 origin{0.0};
+    double inverseEdge = 1.0;
+    std::array<float, 3> low{};
+    std::array<float, 3> high{};
+
+    // `offset`: added to stored floats to get source coordinates. `bounds`: those the
+    // normalizer was built with.
+    FloatUnitTransform(const SourceNormalizer& normalizer, const CubeTransform& cube,
+                       const Bounds& bounds, const glm::dvec3& offset);
+};
+
+struct FloatRecordOutputs {
+    glm::vec3* positions = nullptr;
+    glm::vec3* normals = nullptr;  // when the layout has normals
+    glm::u8vec3* colors = nullptr; // when the layout has colours
+};
+
+// Converts records in order while each lies inside the transform's box, writing position i
+// as float(((double(x) + offset) - origin) * inverseEdge), exactly SourceNormalizer::toUnit,
+// plus its normal and colour. Returns how many were converted: `count`, or the index of the
+// first record that needs the caller's exact handling.
+std::size_t convertFloatRecords(const std::uint8_t* records, std::size_t count,
+                                const FloatRecordLayout& layout,
+                                const FloatUnitTransform& transform,
+                                const FloatRecordOutputs& outputs);
+
+} // namespace omicron

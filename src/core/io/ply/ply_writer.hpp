@@ -1,0 +1,35 @@
+// Writes a point batch as PLY (ascii or binary, either endianness), atomically.
+#pragma once
+
+#include "io/atomic_file_writer.hpp"
+#include "points/cube_transform.hpp"
+#include "points/point_batch.hpp"
+
+#include <string>
+#include <vector>
+
+namespace omicron {
+
+enum class PlyEncoding { Ascii, BinaryLittleEndian, BinaryBigEndian };
+
+struct PlyWriteOptions {
+    PlyEncoding encoding = PlyEncoding::BinaryLittleEndian;
+    // Stored coordinates are float(source - offset); a non-zero offset is recorded as a
+    // "comment offset X Y Z" line (the convention of ../shared/data), so georeferenced clouds
+    // keep their precision.
+    glm::dvec3 offset{0.0};
+    std::vector<std::string> comments; // extra "comment" lines
+};
+
+// The offset to store float coordinates against: `preferred` (e.g. the source file's own
+// offset) when float keeps millimetre steps relative to it, else the cube's origin rounded to
+// whole units, so georeferenced clouds (LAS with coordinates of 10^6) keep their precision.
+glm::dvec3 plyStorageOffset(const CubeTransform& cube, const glm::dvec3& preferred);
+
+// Writes every point of `points` (positions mapped back to source units with `cube`) with
+// the attributes the batch has: float x y z, float nx ny nz, uchar red green blue, ushort
+// intensity. Throws OutputError; the target is untouched on failure.
+void writePly(const std::string& path, const PointBatch& points, const CubeTransform& cube,
+              const PlyWriteOptions& options = {});
+
+} // namespace omicron

@@ -1,0 +1,53 @@
+// The bounds pre-pass's link to whoever opens the file: progress once per block of input and
+// the cancel check, so that a front end can show "scanning bounds" and stop a long scan of a
+// large PLY or XYZ file (a scan reads the whole file once before any point is delivered).
+#pragma once
+
+#include "io/point_reader.hpp"
+
+#include <cstdint>
+#include <string>
+
+namespace omicron {
+
+class PrePassMonitor {
+public:
+    // Reports (and checks the cancel flag) whenever the scan has advanced this many bytes:
+    // the size of the readers' blocks, so a binary scan reports once per block.
+    static constexpr std::uint64_t kReportBytes = std::uint64_t{1} << 20;
+
+    PrePassMonitor(const OpenOptions& options, std::string path, std::uint64_t fileBytes)
+        : m_options(options), m_path(std::move(path)), m_fileBytes(fileBytes) {}
+
+    // The scan has read the file up to byte `offset`. Cheap between reports (one compare),
+    // so text scans call it per line. False once cancelled: a block visitor returns it to stop
+    // the scan, which then ends with finish().
+    bool reached(std::uint64_t offset) { return offset < m_nextReport || report(offset); }
+    // The same, for a scan that can stop where it stands: throws OpenCancelled when cancelled.
+    void advance(std::uint64_t offset) {
+        if (!reached(offset)) {
+            throwCancelled();
+        }
+    }
+    // The scan is over: throws OpenCancelled when it was stopped, else a last report at the
+    // file's size.
+    void finish() {
+        if (m_cancelled) {
+            throwCancelled();
+        }
+        report(m_fileBytes);
+    }
+
+private:
+    bool report(std::uint64_t offset);
+    [[noreturn]] void throwCancelled() const;
+
+    const OpenOptions& m_options;
+    std::string m_path;
+    std::uint64_t m_fileBytes;
+    std::uint64_t m_nextReport = 0; // the first call reports: a scan starts visibly
+    bool m_cancelled = false;
+    std::uint64_t m_bytesScanned = 0;
+};
+
+} // namespace omicron

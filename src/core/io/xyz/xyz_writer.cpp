@@ -1,0 +1,88 @@
+#include "io/xyz/xyz_writer.hpp"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+
+namespace omicron {
+
+namespace {
+
+constexpr int kNormalDecimals = 6;
+
+// Decimals that keep a unit-cube float's resolution (edge * 2^-24) in source units, plus one.
+int positionDecimals(double edge) {
+    const double resolution = edge * 0x1.0p-24;
+    return std::clamp(static_cast<int>(std::ceil(-std::log10(resolution))) + 1, 0, 17);
+}
+
+class LineBuilder {
+public:
+    void number(double value, int decimals) {
+        separate();
+        const auto result = std::to_chars(m_cursor, m_text.data() + m_text.size(), value,
+                                          std::chars_format::fixed, decimals);
+        m_cursor = result.ptr;
+    }
+    void integer(unsigned value) {
+        separate();
+        m_cursor = std::to_chars(m_cursor, m_text.data() + m_text.size(), value).ptr;
+    }
+    void finish(AtomicFileWriter& out) {
+        *m_cursor++ = '\n';
+        out.write(m_text.data(), static_cast<std::size_t>(m_cursor - m_text.data()));
+        m_cursor = m_text.data();
+    }
+
+private:
+    void separate() {
+        if (m_cursor != m_text.data()) {
+            *m_cursor++ = ' ';
+        }
+    }
+    // Ten fixed-point numbers of at most 17 decimals and 309 integer digits fit easily.
+    std::array<char, 4096> m_text{};
+    char* m_cursor = m_text.data();
+};
+
+} // namespace
+
+void writeXyz(const std::string& path, const PointBatch& points, const CubeTransform& cube,
+              const glm::dvec3& offset) {
+    const bool normals = points.attributes.has(Attribute::Normal);
+    const bool colors = points.attributes.has(Attribute::Color);
+    const bool intensities = points.attributes.has(Attribute::Intensity) && !normals;
+    const int decimals = positionDecimals(cube.edge);
+
+    AtomicFileWriter out(path);
+    std::string header = "# x y z";
+    header += intensities ? " intensity" : "";
+    header += colors ? " r g b" : "";
+    header += normals ? " nx ny nz" : "";
+    out.write(header + "\n");
+    LineBuilder line;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const glm::dvec3 source = cube.toSource(points.positions[i]) - offset;
+        line.number(source.x, decimals);
+        line.number(source.y, decimals);
+        line.number(source.z, decimals);
+        if (intensities) {
+            line.integer(points.intensities[i]);
+        }
+        if (colors) {
+            for (int c = 0; c < 3; ++c) {
+                line.integer(points.colors[i][c]);
+            }
+        }
+        if (normals) {
+            for (int c = 0; c < 3; ++c) {
+                line.number(points.normals[i][c], kNormalDecimals);
+            }
+        }
+        line.finish(out);
+    }
+    out.commit();
+}
+
+} // namespace omicron

@@ -1,0 +1,493 @@
+#include "pipeline/build_pipeline.hpp"
+
+#include "formats/omh_reader.hpp"
+#include "formats/oms_reader.hpp"
+#include "scene/scene_generator.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+
+namespace omicron {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Copies points [begin, end) of `from` into `to` (same attributes), reusing its capacity.
+void copySlice(const PointBatch& from, std::size_t begin, std::size_t end, PointBatch& to) {
+    to.clear();
+    to.attributes = from.attributes;
+    const auto slice = [&](const auto& source, auto& target) {
+        if (!source.empty()) {
+            target.assign(source.begin() + static_cast<std::ptrdiff_t>(begin),
+                          source.begin() + static_cast<std::ptrdiff_t>(end));
+        }
+    };
+    slice(from.positions, to.positions);
+    slice(from.normals, to.normals);
+    slice(from.colors, to.colors);
+    slice(from.intensities, to.intensities);
+}
+
+std::string describeCloud(const CloudInfo& info) {
+    std::string text = info.formatDetail.empty() ? toString(info.format) : info.formatDetail;
+    return text + ", " + std::to_string(info.pointCount) + " points";
+}
+
+} // namespace
+
+const char* toString(BuildPhase phase) {
+    switch (phase) {
+    case BuildPhase::Idle:
+        return "idle";
+    case BuildPhase::Opening:
+        return "opening";
+    case BuildPhase::Reading:
+        return "reading";
+    case BuildPhase::Sorting:
+        return "sorting";
+    case BuildPhase::Building:
+        return "building";
+    case BuildPhase::Complete:
+        return "complete";
+    case BuildPhase::Cancelled:
+        return "cancelled";
+    case BuildPhase::Failed:
+        return "failed";
+    }
+    return "unknown";
+}
+
+const char* toString(PipelineKind kind) {
+    switch (kind) {
+    case PipelineKind::UnsortedCloud:
+        return "unsorted cloud -> incremental sorter -> builder";
+    case PipelineKind::SortedStream:
+        return "sorted stream (.oms) -> builder";
+    case PipelineKind::GeneratedScene:
+        return "generated scene -> incremental sorter -> builder";
+    case PipelineKind::HierarchyFile:
+        return "saved hierarchy (.omh) -> top-down load";
+    }
+    return "unknown";
+}
+
+// The pointers a failed run must give back; guarded by m_mutex when touched.
+struct PipelineState {
+    std::optional<PipelineSource> source;
+    std::shared_ptr<const SortedCloud> cloud;
+    std::shared_ptr<HierarchyBuilder> builder;
+    std::shared_ptr<const Hierarchy> loaded;
+    BuildStatistics loadedStatistics;
+    BuildOptions loadedOptions;
+};
+
+PipelineResult BuildPipeline::run(const std::string& path, const PipelineOptions& options) {
+    validate(options.build); // std::invalid_argument before anything is touched
+    PipelineState saved;
+    {
+        std::lock_guard lock(m_mutex);
+        saved = {m_source, m_cloud, m_builder, m_loaded, m_loadedStatistics, m_loadedOptions};
+    }
+    try {
+        if (isOmhFile(path)) {
+            return runHierarchyFile(path);
+        }
+        return isOmsFile(path) ? runSortedStream(path, options) : runCloud(path, options);
+    } catch (...) {
+        // A bad file changes nothing: the previous source, cloud and hierarchy stay shown.
+        setPhase(BuildPhase::Failed);
+        std::lock_guard lock(m_mutex);
+        m_sorter.reset();
+        m_source = std::move(saved.source);
+        m_cloud = std::move(saved.cloud);
+        m_builder = std::move(saved.builder);
+        m_loaded = std::move(saved.loaded);
+        m_loadedStatistics = std::move(saved.loadedStatistics);
+        m_loadedOptions = saved.loadedOptions;
+        m_pointsTotal.store(m_source ? m_source->pointCount : 0);
+        throw;
+    }
+}
+
+PipelineResult BuildPipeline::runHierarchyFile(const std::string& path) {
+    beginRun(BuildPhase::Opening);
+    const auto start = Clock::now();
+    OmhReader reader(path); // header, level table and footer checked: throws before any change
+    const omh::Header& header = reader.header();
+    PipelineSource source;
+    source.path = path;
+    source.kind = PipelineKind::HierarchyFile;
+    source.description = "OMiCroN hierarchy (.omh), " + std::to_string(header.totalNodes) +
+                         " nodes, " + std::to_string(header.totalPoints) + " point records";
+    source.pointCount = header.totalPoints;
+    source.attributes = header.attributes;
+    source.cube = header.cube;
+    source.sourceOffset = header.sourceOffset;
+
+    BuildStatistics statistics;
+    statistics.inputPoints = header.build.inputPoints;
+    statistics.droppedPoints = header.build.droppedPoints;
+    statistics.collapsedLeaves = header.build.collapsedLeaves;
+    for (const omh::LevelEntry& level : header.levels) {
+        statistics.levels.push_back({level.nodes, level.leaves, level.points});
+    }
+    m_sourceReads.fetch_add(1);
+    {
+        std::lock_guard lock(m_mutex);
+        m_source = source;
+        m_cloud.reset(); // a loaded file has no sorted cloud to rebuild or export from
+        m_builder.reset();
+        m_loaded = reader.hierarchy();
+        m_loadedStatistics = statistics;
+        m_loadedOptions.maxLevel = header.build.maxLevel;
+        m_loadedOptions.ratio = header.build.ratio;
+        m_loadedOptions.collapse = header.build.collapse;
+        m_pointsTotal.store(source.pointCount);
+    }
+    setPhase(BuildPhase::Reading);
+    std::uint64_t pointsLoaded = 0;
+    reader.load(
+        [&](int level) {
+            pointsLoaded += header.levels[static_cast<std::size_t>(level)].points;
+            m_pointsRead.store(pointsLoaded);
+        },
+        &m_cancel);
+    PipelineResult result;
+    result.source = source;
+    result.pipeline = toString(PipelineKind::HierarchyFile);
+    result.readSeconds = secondsSince(start);
+    result.cancelled = cancelled();
+    statistics.complete = !result.cancelled;
+    statistics.creationSeconds = result.readSeconds;
+    {
+        std::lock_guard lock(m_mutex);
+        m_loadedStatistics = statistics;
+    }
+    result.stats = statistics;
+    setPhase(result.cancelled ? BuildPhase::Cancelled : BuildPhase::Complete);
+    return result;
+}
+
+void BuildPipeline::beginRun(BuildPhase phase) {
+    m_pointsRead.store(0);
+    m_bytesScanned.store(0);
+    m_bytesToScan.store(0);
+    m_generation.fetch_add(1);
+    setPhase(phase);
+}
+
+void BuildPipeline::setSource(const PipelineSource& source,
+                              std::shared_ptr<const SortedCloud> cloud) {
+    std::lock_guard lock(m_mutex);
+    m_source = source;
+    m_cloud = std::move(cloud);
+    m_builder.reset();
+    m_loaded.reset();
+    m_pointsTotal.store(source.pointCount);
+}
+
+std::shared_ptr<HierarchyBuilder> BuildPipeline::startBuilder(const BuildOptions& options) {
+    std::lock_guard lock(m_mutex);
+    m_builder = std::make_shared<HierarchyBuilder>(m_cloud, options);
+    return m_builder;
+}
+
+PipelineResult BuildPipeline::finishBuild(HierarchyBuilder& builder, PipelineResult result) {
+    if (cancelled()) {
+        builder.cancel();
+    } else {
+        setPhase(BuildPhase::Building);
+    }
+    builder.finish();
+    builder.wait();
+    result.stats = builder.statistics();
+    result.cancelled = result.cancelled || cancelled() || !result.stats.complete;
+    setPhase(result.cancelled ? BuildPhase::Cancelled : BuildPhase::Complete);
+    return result;
+}
+
+PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOptions& options) {
+    beginRun(BuildPhase::Opening);
+    OpenOptions openOptions;
+    openOptions.cancel = &m_cancel;
+    openOptions.onPrePassProgress = [&](std::uint64_t scanned, std::uint64_t fileBytes) {
+        m_bytesToScan.store(fileBytes, std::memory_order_relaxed);
+        m_bytesScanned.store(scanned, std::memory_order_relaxed);
+        if (m_prePassObserver) {
+            m_prePassObserver(scanned, fileBytes);
+        }
+    };
+    std::unique_ptr<PointReader> reader;
+    try {
+        reader = openPointCloud(path, openOptions);
+    } catch (const OpenCancelled&) {
+        // Nothing was replaced yet: the previous source, cloud and hierarchy stay.
+        setPhase(BuildPhase::Cancelled);
+        PipelineResult result;
+        result.pipeline = toString(PipelineKind::UnsortedCloud);
+        result.source.path = path;
+        result.cancelled = true;
+        return result;
+    }
+    const CloudInfo& info = reader->info();
+    SortOptions sortOptions;
+    sortOptions.chunks = options.sortChunks;
+    sortOptions.cancel = &m_cancel;
+    sortOptions.storage = options.storage;
+    auto sorter = std::make_shared<IncrementalMortonSorter>(info, sortOptions);
+    PipelineResult result;
+    result.pipeline = toString(PipelineKind::UnsortedCloud);
+    result.source = {path,
+                     describeCloud(info),
+                     PipelineKind::UnsortedCloud,
+                     info.pointCount,
+                     info.attributes,
+                     info.cube,
+                     info.sourceOffset};
+    setSource(result.source, sorter->cloud());
+    {
+        std::lock_guard lock(m_mutex);
+        m_sorter = sorter;
+    }
+    const auto builder = startBuilder(options.build);
+    m_sourceReads.fetch_add(1);
+    setPhase(BuildPhase::Reading);
+    ReadOptions readOptions;
+    readOptions.batchPoints = sortOptions.batchPoints;
+    readOptions.cancel = &m_cancel;
+    const auto readStart = Clock::now();
+    const ReadSummary read = reader->read(
+        [&](const PointBatch& batch) {
+            sorter->add(batch);
+            m_pointsRead.fetch_add(batch.size(), std::memory_order_relaxed);
+        },
+        readOptions);
+    result.readSeconds = secondsSince(readStart);
+    result.skippedNonFinite = read.skippedNonFinite;
+    result.cancelled = read.cancelled;
+    if (!result.cancelled) {
+        setPhase(BuildPhase::Sorting);
+        const auto sortStart = Clock::now();
+        sorter->sortAndEmit(builder->consumer());
+        result.sortSeconds = secondsSince(sortStart);
+    }
+    {
+        // The sorter's unsorted copy of the input is as large as the cloud: let it go.
+        std::lock_guard lock(m_mutex);
+        m_sorter.reset();
+    }
+    return finishBuild(*builder, std::move(result));
+}
+
+PipelineResult BuildPipeline::runSortedStream(const std::string& path,
+                                              const PipelineOptions& options) {
+    beginRun(BuildPhase::Opening);
+    OmsReader reader(path, options.storage);
+    const OmsInfo& info = reader.info();
+    PipelineResult result;
+    result.pipeline = toString(PipelineKind::SortedStream);
+    result.source = {path,
+                     "omicron sorted stream v" + std::to_string(info.version) + ", " +
+                         std::to_string(info.pointCount) + " points",
+                     PipelineKind::SortedStream,
+                     info.pointCount,
+                     info.attributes,
+                     info.cube,
+                     info.sourceOffset};
+    setSource(result.source, reader.cloud());
+    const auto builder = startBuilder(options.build);
+    m_sourceReads.fetch_add(1);
+    setPhase(BuildPhase::Sorting);
+    ReadOptions readOptions;
+    readOptions.cancel = &m_cancel;
+    const auto readStart = Clock::now();
+    const SortedRangeConsumer forward = builder->consumer();
+    const ReadSummary read = reader.read(
+        [&](const SortedCloud& cloud, std::size_t begin, std::size_t end) {
+            m_pointsRead.store(end, std::memory_order_relaxed);
+            forward(cloud, begin, end);
+        },
+        readOptions);
+    result.readSeconds = secondsSince(readStart);
+    result.cancelled = read.cancelled;
+    return finishBuild(*builder, std::move(result));
+}
+
+PipelineResult BuildPipeline::runGeneratedScene(std::uint64_t points, std::uint64_t seed,
+                                                const PipelineOptions& options) {
+    validate(options.build);
+    beginRun(BuildPhase::Opening);
+    if (cancelled()) { // generation itself cannot stop part way: do not start it
+        setPhase(BuildPhase::Cancelled);
+        PipelineResult result;
+        result.cancelled = true;
+        return result;
+    }
+    const GeneratedScene scene = generateScene(points, seed);
+    CloudInfo info;
+    info.format = CloudFormat::Xyz; // unused for a sorter fed from memory
+    info.formatDetail = "generated scene (seed " + std::to_string(seed) + ")";
+    info.pointCount = scene.points.size();
+    info.attributes = scene.points.attributes;
+    info.sourceBounds = scene.sourceBounds;
+    info.boundsFromHeader = true;
+    info.cube = scene.cube;
+    SortOptions sortOptions;
+    sortOptions.chunks = options.sortChunks;
+    sortOptions.cancel = &m_cancel;
+    sortOptions.storage = options.storage;
+    auto sorter = std::make_shared<IncrementalMortonSorter>(info, sortOptions);
+    PipelineResult result;
+    result.pipeline = toString(PipelineKind::GeneratedScene);
+    result.source = {"",
+                     describeCloud(info),
+                     PipelineKind::GeneratedScene,
+                     info.pointCount,
+                     info.attributes,
+                     info.cube,
+                     info.sourceOffset};
+    setSource(result.source, sorter->cloud());
+    {
+        std::lock_guard lock(m_mutex);
+        m_sorter = sorter;
+    }
+    const auto builder = startBuilder(options.build);
+    m_sourceReads.fetch_add(1);
+    setPhase(BuildPhase::Reading);
+    const auto readStart = Clock::now();
+    PointBatch batch;
+    for (std::size_t begin = 0; begin < scene.points.size() && !cancelled();
+         begin += sortOptions.batchPoints) {
+        const std::size_t end = std::min(scene.points.size(), begin + sortOptions.batchPoints);
+        copySlice(scene.points, begin, end, batch);
+        sorter->add(batch);
+        m_pointsRead.fetch_add(batch.size(), std::memory_order_relaxed);
+    }
+    result.readSeconds = secondsSince(readStart);
+    if (!cancelled()) {
+        setPhase(BuildPhase::Sorting);
+        const auto sortStart = Clock::now();
+        sorter->sortAndEmit(builder->consumer());
+        result.sortSeconds = secondsSince(sortStart);
+    }
+    {
+        std::lock_guard lock(m_mutex);
+        m_sorter.reset();
+    }
+    return finishBuild(*builder, std::move(result));
+}
+
+PipelineResult BuildPipeline::rebuild(const BuildOptions& options) {
+    validate(options);
+    std::shared_ptr<const SortedCloud> cloud;
+    PipelineResult result;
+    {
+        std::lock_guard lock(m_mutex);
+        if (!m_cloud || !m_cloud->complete() || !m_source) {
+            throw std::logic_error("rebuild needs a completely sorted cloud; none is kept");
+        }
+        cloud = m_cloud;
+        result.source = *m_source;
+    }
+    beginRun(BuildPhase::Building);
+    m_pointsRead.store(cloud->sortedEnd());
+    result.pipeline = "kept sorted cloud -> builder (rebuild)";
+    const auto builder = startBuilder(options);
+    // One range for the whole cloud: the builder cuts it into worklists itself, and the
+    // result does not depend on how the input was split into ranges.
+    builder->onSortedRange(*cloud, 0, cloud->sortedEnd());
+    return finishBuild(*builder, std::move(result));
+}
+
+void BuildPipeline::cancel() {
+    m_cancel.store(true);
+    std::shared_ptr<HierarchyBuilder> builder;
+    {
+        std::lock_guard lock(m_mutex);
+        builder = m_builder;
+    }
+    if (builder) {
+        builder->cancel();
+    }
+}
+
+PipelineProgress BuildPipeline::progress() const {
+    PipelineProgress progress;
+    progress.phase = static_cast<BuildPhase>(m_phase.load());
+    progress.generation = m_generation.load();
+    progress.pointsTotal = m_pointsTotal.load();
+    progress.pointsRead = m_pointsRead.load(std::memory_order_relaxed);
+    progress.bytesToScan = m_bytesToScan.load(std::memory_order_relaxed);
+    progress.bytesScanned = m_bytesScanned.load(std::memory_order_relaxed);
+    std::shared_ptr<HierarchyBuilder> builder;
+    std::shared_ptr<const SortedCloud> cloud;
+    {
+        std::lock_guard lock(m_mutex);
+        builder = m_builder;
+        cloud = m_cloud;
+    }
+    if (cloud) {
+        progress.pointsSorted = cloud->sortedEnd();
+    }
+    if (builder) {
+        progress.pointsInserted = builder->statistics().inputPoints;
+        progress.cutDelimiter = builder->hierarchy().publishedCut().delimiter;
+        progress.maxLevel = builder->options().maxLevel;
+    }
+    return progress;
+}
+
+PreviewSample BuildPipeline::preview() const {
+    std::shared_ptr<const IncrementalMortonSorter> sorter;
+    {
+        std::lock_guard lock(m_mutex);
+        sorter = m_sorter;
+    }
+    return sorter ? sorter->preview() : PreviewSample{};
+}
+
+std::optional<PipelineSource> BuildPipeline::source() const {
+    std::lock_guard lock(m_mutex);
+    return m_source;
+}
+
+std::shared_ptr<const SortedCloud> BuildPipeline::sortedCloud() const {
+    std::lock_guard lock(m_mutex);
+    return m_cloud;
+}
+
+std::shared_ptr<const Hierarchy> BuildPipeline::hierarchy() const {
+    std::lock_guard lock(m_mutex);
+    return m_builder ? m_builder->sharedHierarchy() : m_loaded;
+}
+
+BuildStatistics BuildPipeline::statistics() const {
+    std::shared_ptr<HierarchyBuilder> builder;
+    {
+        std::lock_guard lock(m_mutex);
+        builder = m_builder;
+    }
+    if (builder) {
+        return builder->statistics();
+    }
+    std::lock_guard lock(m_mutex);
+    return m_loaded ? m_loadedStatistics : BuildStatistics{};
+}
+
+BuildOptions BuildPipeline::hierarchyOptions() const {
+    std::lock_guard lock(m_mutex);
+    return m_builder ? m_builder->options() : m_loadedOptions;
+}
+
+bool BuildPipeline::hasCompleteCloud() const {
+    std::lock_guard lock(m_mutex);
+    return m_cloud && m_cloud->complete();
+}
+
+} // namespace omicron

@@ -1,0 +1,115 @@
+#include "points/sorted_cloud.hpp"
+
+namespace omicron {
+
+const char* toString(PointStorage storage) {
+    return storage == PointStorage::Packed ? "packed" : "exact";
+}
+
+bool parsePointStorage(std::string_view text, PointStorage& out) {
+    if (text == "exact") {
+        out = PointStorage::Exact;
+    } else if (text == "packed") {
+        out = PointStorage::Packed;
+    } else {
+        return false;
+    }
+    return true;
+}
+
+SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffset,
+                         AttributeSet attributes, std::size_t capacity, CloudOrder order,
+                         PointStorage storage)
+    : m_cube(cube), m_sourceOffset(sourceOffset), m_attributes(attributes), m_order(order),
+      m_capacity(capacity), m_positions(storage == PointStorage::Exact ? capacity : 0),
+      m_normals(attributes.has(Attribute::Normal) ? capacity : 0),
+      m_colors(storage == PointStorage::Exact && attributes.has(Attribute::Color) ? capacity : 0),
+      m_intensities(attributes.has(Attribute::Intensity) ? capacity : 0),
+      m_blockCodes(order == CloudOrder::Morton ? blockCodeCount(capacity) : 0) {
+    if (storage == PointStorage::Packed) {
+        m_packed =
+            std::make_unique<PackedPointStore>(capacity, attributes.has(Attribute::Color));
+    }
+}
+
+SortedCloud::StagedRange SortedCloud::stage(std::size_t end) {
+    const std::size_t begin = m_sortedEnd.load(std::memory_order_relaxed);
+    assert(begin <= end && end <= m_capacity);
+    const std::size_t count = end - begin;
+    const auto inPlace = [&](auto& array) {
+        return array.size() == 0 ? std::span<std::remove_reference_t<decltype(array[0])>>()
+                                 : std::span(array.data() + begin, count);
+    };
+    StagedRange staged{inPlace(m_positions), inPlace(m_normals), inPlace(m_colors),
+                       inPlace(m_intensities)};
+    if (m_packed) {
+        m_stagedPositions.resize(count);
+        staged.positions = m_stagedPositions;
+        if (m_packed->hasColors()) {
+            m_stagedColors.resize(count);
+            staged.colors = m_stagedColors;
+        }
+    }
+    return staged;
+}
+
+void SortedCloud::publish(std::size_t newSortedEnd) {
+    const std::size_t previous = m_sortedEnd.load(std::memory_order_relaxed);
+    assert(newSortedEnd >= previous && newSortedEnd <= capacity());
+    if (m_packed && newSortedEnd > previous) {
+        // Encodes what stage() handed out (all of it: a packed cloud publishes whole stages).
+        assert(m_stagedPositions.size() == newSortedEnd - previous);
+        m_packed->append(m_stagedPositions, m_stagedColors);
+        m_stagedPositions.clear();
+        m_stagedColors.clear();
+    }
+    assert(m_order != CloudOrder::Morton || previous == 0 || newSortedEnd == previous ||
+           code(previous - 1) <= code(previous));
+    if (m_blockCodes.size() != 0) {
+        for (std::size_t block = blockCodeCount(previous); block < blockCodeCount(newSortedEnd);
+             ++block) {
+            m_blockCodes[block] = code(block * kBlockCodePoints);
+        }
+    }
+    m_sortedEnd.store(newSortedEnd, std::memory_order_release);
+}
+
+void SortedCloud::markComplete() {
+    // Staging buffers are only needed while a producer writes.
+    m_stagedPositions = {};
+    m_stagedColors = {};
+    m_complete.store(true, std::memory_order_release);
+}
+
+std::size_t SortedCloud::bytesResident() const {
+    return positions().size_bytes() + normals().size_bytes() + colors().size_bytes() +
+           intensities().size_bytes() + m_blockCodes.size() * sizeof(morton::Code) +
+           (m_packed ? m_packed->bytesResident() : 0);
+}
+
+void SortedCloud::copyRange(std::size_t begin, std::size_t end, PointBatch& out) const {
+    assert(begin <= end && end <= sortedEnd());
+    out.attributes = m_attributes;
+    out.positions.resize(end - begin);
+    for (std::size_t i = begin; i < end; ++i) {
+        out.positions[i - begin] = position(i);
+    }
+    out.colors.clear();
+    if (hasColors()) {
+        out.colors.resize(end - begin);
+        for (std::size_t i = begin; i < end; ++i) {
+            out.colors[i - begin] = color(i);
+        }
+    }
+    const auto copyInto = [&](auto from, auto& to) {
+        if (!from.empty()) {
+            to.assign(from.begin() + begin, from.begin() + end);
+        } else {
+            to.clear();
+        }
+    };
+    copyInto(normals(), out.normals);
+    copyInto(intensities(), out.intensities);
+}
+
+} // namespace omicron

@@ -1,0 +1,157 @@
+// A point cloud in Morton order that grows by its sorted prefix.
+//
+// Points keep their positions (unit cube), not their codes: a level-21 code is
+// morton::encodeUnit(position), bit for bit what the sorter sorted by, so storing it would
+// cost 8 bytes a point for nothing (a third of the cloud). Scans that only ask "same cell?"
+// test positions against a UnitCellBox, which needs no bit interleaving.
+//
+// The arrays are allocated once, for the cloud's full capacity, and never move. A producer
+// (the incremental sorter, or the .oms reader) fills them front to back and publishes the end
+// of the finished prefix with a release store; any thread that loads sortedEnd() (acquire) may
+// read [0, sortedEnd()) without locks: that part never changes again. This is the hand-off
+// between the sorting stage and the hierarchy builder (pipelines 1 and 2 of the paper).
+//
+// A Morton-ordered cloud also keeps the code of every 64th point (block_codes.hpp), written by
+// publish(): cutting the stream into leaves reads it instead of most positions.
+//
+// Positions and colours live in one of two stores (PointStorage): Exact keeps the floats and
+// bytes as read; Packed quantises positions to the level-21 grid and bit-packs both
+// (PackedPointStore: less than half the bytes, every point keeps its code). Read them through
+// position(i) / color(i), or visitPositions() in hot loops; positions() / colors() expose the
+// exact arrays only.
+#pragma once
+
+#include "points/block_codes.hpp"
+#include "points/cube_transform.hpp"
+#include "points/huge_page_buffer.hpp"
+#include "points/morton.hpp"
+#include "points/packed_points.hpp"
+#include "points/point_batch.hpp"
+#include "points/position_views.hpp"
+
+#include <atomic>
+#include <cassert>
+#include <cstddef>
+#include <glm/vec3.hpp>
+#include <memory>
+#include <span>
+#include <string_view>
+#include <vector>
+
+namespace omicron {
+
+// The order the points of a cloud are stored in.
+enum class CloudOrder {
+    Morton, // non-decreasing level-21 code: what the sorter and the .oms reader produce and the
+            // builder needs (publish() asserts it at range boundaries)
+    // The held points of a stored hierarchy's nodes, concatenated in node (breadth-first)
+    // order, as the .omh reader loads them: a parent's sample repeats points of its leaves,
+    // and codes restart at every level. Only a loaded Hierarchy indexes such a cloud.
+    NodeOrder,
+};
+
+// How a cloud keeps its positions and colours.
+enum class PointStorage {
+    Exact,  // the floats and bytes as read (12 + 3 bytes a point)
+    Packed, // level-21 cell centres and colours, bit-packed per 64 points (PackedPointStore)
+};
+const char* toString(PointStorage storage);
+// "exact" or "packed"; false for anything else.
+bool parsePointStorage(std::string_view text, PointStorage& out);
+
+class SortedCloud {
+public:
+    SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffset, AttributeSet attributes,
+                std::size_t capacity, CloudOrder order = CloudOrder::Morton,
+                PointStorage storage = PointStorage::Exact);
+
+    SortedCloud(const SortedCloud&) = delete;
+    SortedCloud& operator=(const SortedCloud&) = delete;
+
+    const CubeTransform& cube() const { return m_cube; }
+    const glm::dvec3& sourceOffset() const { return m_sourceOffset; }
+    AttributeSet attributes() const { return m_attributes; }
+    CloudOrder order() const { return m_order; }
+    PointStorage storage() const { return m_packed ? PointStorage::Packed : PointStorage::Exact; }
+    std::size_t capacity() const { return m_capacity; }
+
+    // End of the finished prefix; everything before it is immutable.
+    std::size_t sortedEnd() const { return m_sortedEnd.load(std::memory_order_acquire); }
+    // True once the producer declared the cloud complete (sortedEnd() is then the point count).
+    bool complete() const { return m_complete.load(std::memory_order_acquire); }
+
+    // Read access; index only below a sortedEnd() value this thread has loaded.
+    // The level-21 code of point `i` (computed from its position).
+    morton::Code code(std::size_t i) const {
+        const glm::vec3 p = position(i);
+        return morton::encodeUnit(p.x, p.y, p.z);
+    }
+    glm::vec3 position(std::size_t i) const {
+        return m_packed ? m_packed->position(i) : m_positions[i];
+    }
+    bool hasColors() const { return m_attributes.has(Attribute::Color); }
+    glm::u8vec3 color(std::size_t i) const { return m_packed ? m_packed->color(i) : m_colors[i]; }
+    // Calls f(ExactPositions) or f(PackedPositions): one loop, compiled for each store.
+    template <typename F> decltype(auto) visitPositions(F&& f) const {
+        if (m_packed) {
+            return f(PackedPositions{m_packed.get()});
+        }
+        return f(ExactPositions{m_positions.data()});
+    }
+    // The block codes of points [0, end), end <= a loaded sortedEnd() (empty for NodeOrder).
+    BlockCodes blockCodes(std::size_t end) const {
+        return BlockCodes(m_blockCodes.data(), m_blockCodes.size() == 0 ? 0 : blockCodeCount(end));
+    }
+    // The exact store's arrays (empty for a packed cloud).
+    std::span<const glm::vec3> positions() const { return m_positions; }
+    std::span<const glm::u8vec3> colors() const { return m_colors; }
+    // Either store keeps these as read.
+    std::span<const glm::vec3> normals() const { return m_normals; }
+    std::span<const std::uint16_t> intensities() const { return m_intensities; }
+
+    // Producer side. The exact store is written in place, beyond sortedEnd(), then published:
+    std::span<glm::vec3> mutablePositions() { return m_positions; }
+    std::span<glm::vec3> mutableNormals() { return m_normals; }
+    std::span<glm::u8vec3> mutableColors() { return m_colors; }
+    std::span<std::uint16_t> mutableIntensities() { return m_intensities; }
+    // ...or, for either store, the next points [sortedEnd(), end) are written through the spans
+    // stage() returns (indexed from 0; an attribute the cloud lacks is empty) and published by
+    // publish(end). For a packed cloud positions and colours go to a staging buffer that
+    // publish() encodes.
+    struct StagedRange {
+        std::span<glm::vec3> positions;
+        std::span<glm::vec3> normals;
+        std::span<glm::u8vec3> colors;
+        std::span<std::uint16_t> intensities;
+    };
+    StagedRange stage(std::size_t end);
+
+    void publish(std::size_t newSortedEnd);
+    void markComplete();
+
+    // Bytes of every array and store the cloud holds.
+    std::size_t bytesResident() const;
+
+    // Copies [begin, end) into a batch (e.g. for a writer or a test).
+    void copyRange(std::size_t begin, std::size_t end, PointBatch& out) const;
+
+private:
+    CubeTransform m_cube;
+    glm::dvec3 m_sourceOffset;
+    AttributeSet m_attributes;
+    CloudOrder m_order;
+    std::size_t m_capacity;
+    // On huge pages, uninitialised: the producer writes [0, capacity) before publishing.
+    HugePageArray<glm::vec3> m_positions;
+    HugePageArray<glm::vec3> m_normals;
+    HugePageArray<glm::u8vec3> m_colors;
+    HugePageArray<std::uint16_t> m_intensities;
+    HugePageArray<morton::Code> m_blockCodes;    // CloudOrder::Morton only
+    std::unique_ptr<PackedPointStore> m_packed; // Packed storage only
+    std::vector<glm::vec3> m_stagedPositions;   // Packed: the range stage() handed out
+    std::vector<glm::u8vec3> m_stagedColors;
+    std::atomic<std::size_t> m_sortedEnd{0};
+    std::atomic<bool> m_complete{false};
+};
+
+} // namespace omicron

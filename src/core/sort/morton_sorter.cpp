@@ -1,0 +1,265 @@
+#include "sort/morton_sorter.hpp"
+
+#include "sort/radix_sort.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+#include <string>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
+
+namespace omicron {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// splitmix64: a fixed, portable hash, so the preview is the same on every machine.
+std::uint64_t mix(std::uint64_t x) {
+    x += 0x9e3779b97f4a7c15ull;
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+    return x ^ (x >> 31);
+}
+
+} // namespace
+
+IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const SortOptions& options)
+    : m_info(info), m_options(options), m_bins(kBins) {
+    if (info.pointCount > UINT32_MAX) {
+        throw std::length_error(info.path + ": " + std::to_string(info.pointCount) +
+                                " points exceed the in-memory sorter's limit of 2^32-1");
+    }
+    m_options.chunks = std::clamp(m_options.chunks, 1, kMaxSortChunks);
+    m_options.batchPoints = std::max<std::size_t>(m_options.batchPoints, 1);
+    const auto capacity = static_cast<std::size_t>(info.pointCount);
+    m_cloud =
+        std::make_shared<SortedCloud>(info.cube, info.sourceOffset, info.attributes, capacity,
+                                      CloudOrder::Morton, m_options.storage);
+    m_input.attributes = info.attributes;
+    m_input.reserve(capacity);
+    const std::size_t perBin = capacity / kBins + 16;
+    for (Bin& bin : m_bins) {
+        bin.codes.reserve(perBin);
+        bin.indices.reserve(perBin);
+    }
+}
+
+void IncrementalMortonSorter::add(const PointBatch& batch) {
+    const std::size_t firstIndex = m_input.size();
+    if (firstIndex + batch.size() > m_cloud->capacity()) {
+        throw std::length_error(m_info.path + ": the reader delivered more points than the " +
+                                std::to_string(m_cloud->capacity()) + " its header declared");
+    }
+    const std::size_t count = batch.size();
+    m_batchCodes.resize(count);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 8192),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                              const glm::vec3& p = batch.positions[i];
+                              m_batchCodes[i] = morton::encodeUnit(p.x, p.y, p.z);
+                          }
+                      });
+    // The counting pass and first distribution, done while the data arrives.
+    constexpr int binShift = 3 * morton::kMaxLevel - kBinBits;
+    for (std::size_t i = 0; i < count; ++i) {
+        const morton::Code code = m_batchCodes[i];
+        Bin& bin = m_bins[(code >> binShift) & (kBins - 1)];
+        bin.codes.push_back(code);
+        bin.indices.push_back(static_cast<std::uint32_t>(firstIndex + i));
+    }
+    m_input.append(batch);
+    samplePreview(batch, firstIndex);
+}
+
+void IncrementalMortonSorter::samplePreview(const PointBatch& batch, std::uint64_t firstIndex) {
+    const std::size_t capacity = m_options.previewPoints;
+    if (capacity == 0) {
+        return;
+    }
+    const bool hasColor = !batch.colors.empty();
+    std::lock_guard lock(m_previewMutex);
+    // Reservoir sampling: point i replaces a random slot with probability capacity / (i + 1).
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+        const std::uint64_t index = firstIndex + i;
+        if (index < capacity) {
+            m_preview.positions.push_back(batch.positions[i]);
+            if (hasColor) {
+                m_preview.colors.push_back(batch.colors[i]);
+            }
+            continue;
+        }
+        const auto slot =
+            static_cast<std::size_t>(mix(m_options.previewSeed ^ index) % (index + 1));
+        if (slot < capacity) {
+            m_preview.positions[slot] = batch.positions[i];
+            if (hasColor) {
+                m_preview.colors[slot] = batch.colors[i];
+            }
+        }
+    }
+    m_preview.pointsSeen = firstIndex + batch.size();
+}
+
+PreviewSample IncrementalMortonSorter::preview() const {
+    std::lock_guard lock(m_previewMutex);
+    return m_preview;
+}
+
+// Bin index where each chunk starts, plus kBins at the end: contiguous bin ranges of about
+// total/K points each (empty chunks are dropped, so all-identical points make one chunk).
+std::vector<std::size_t> IncrementalMortonSorter::chunkBinBoundaries() const {
+    const std::uint64_t total = m_input.size();
+    std::vector<std::size_t> boundaries{0};
+    std::uint64_t accumulated = 0;
+    int chunk = 1;
+    for (std::size_t bin = 0; bin < kBins && chunk < m_options.chunks; ++bin) {
+        accumulated += m_bins[bin].codes.size();
+        const std::uint64_t target = total * static_cast<std::uint64_t>(chunk) /
+                                     static_cast<std::uint64_t>(m_options.chunks);
+        if (accumulated >= target && accumulated > 0 && accumulated < total) {
+            boundaries.push_back(bin + 1);
+            while (chunk < m_options.chunks &&
+                   accumulated >= total * static_cast<std::uint64_t>(chunk) /
+                                      static_cast<std::uint64_t>(m_options.chunks)) {
+                ++chunk;
+            }
+        }
+    }
+    boundaries.push_back(kBins);
+    return boundaries;
+}
+
+int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
+    const auto start = Clock::now();
+    const std::vector<std::size_t> boundaries = chunkBinBoundaries();
+    const std::size_t chunks = boundaries.size() - 1;
+
+    // Chunk c covers sorted positions [chunkBegin[c], chunkBegin[c + 1]).
+    std::vector<std::size_t> chunkBegin(chunks + 1, 0);
+    std::size_t largestChunk = 0;
+    for (std::size_t c = 0; c < chunks; ++c) {
+        std::size_t size = 0;
+        for (std::size_t bin = boundaries[c]; bin < boundaries[c + 1]; ++bin) {
+            size += m_bins[bin].codes.size();
+        }
+        chunkBegin[c + 1] = chunkBegin[c] + size;
+        largestChunk = std::max(largestChunk, size);
+    }
+
+    std::vector<std::uint64_t> keys(largestChunk), keyScratch(largestChunk);
+    std::vector<std::uint32_t> indices(largestChunk), indexScratch(largestChunk);
+    SortedCloud& cloud = *m_cloud;
+    const auto cancelled = [&] {
+        return m_options.cancel != nullptr && m_options.cancel->load(std::memory_order_relaxed);
+    };
+
+    std::size_t nextChunk = 0;
+    int chunksDone = 0;
+    // Stage 1 sorts a chunk (on all cores), stage 2 hands it out; two tokens let the consumer
+    // work on chunk c while chunk c + 1 is sorted, and bound how far sorting runs ahead.
+    tbb::parallel_pipeline(
+        2, tbb::make_filter<void, std::size_t>(
+               tbb::filter_mode::serial_in_order,
+               [&](tbb::flow_control& control) -> std::size_t {
+                   if (nextChunk == chunks || cancelled()) {
+                       control.stop();
+                       return 0;
+                   }
+                   const std::size_t c = nextChunk++;
+                   const std::size_t size = chunkBegin[c + 1] - chunkBegin[c];
+                   // Bins are the first radix digit (already distributed while reading), so
+                   // each bin is sorted on its own, in parallel, in its final place.
+                   std::vector<std::size_t> binOffset(boundaries[c + 1] - boundaries[c] + 1, 0);
+                   for (std::size_t bin = boundaries[c]; bin < boundaries[c + 1]; ++bin) {
+                       binOffset[bin - boundaries[c] + 1] =
+                           binOffset[bin - boundaries[c]] + m_bins[bin].codes.size();
+                   }
+                   tbb::parallel_for(boundaries[c], boundaries[c + 1], [&](std::size_t bin) {
+                       const Bin& from = m_bins[bin];
+                       const std::size_t at = binOffset[bin - boundaries[c]];
+                       const std::size_t n = from.codes.size();
+                       std::copy(from.codes.begin(), from.codes.end(), keys.begin() + at);
+                       std::copy(from.indices.begin(), from.indices.end(), indices.begin() + at);
+                       radixSortByKey(std::span(keys.data() + at, n),
+                                      std::span(indices.data() + at, n),
+                                      std::span(keyScratch.data() + at, n),
+                                      std::span(indexScratch.data() + at, n));
+                   });
+                   // Gather every attribute into its sorted place.
+                   const SortedCloud::StagedRange out = cloud.stage(chunkBegin[c + 1]);
+                   tbb::parallel_for(
+                       tbb::blocked_range<std::size_t>(0, size, 8192),
+                       [&](const tbb::blocked_range<std::size_t>& range) {
+                           for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                               const std::uint32_t from = indices[i];
+                               out.positions[i] = m_input.positions[from];
+                               if (!m_input.normals.empty()) {
+                                   out.normals[i] = m_input.normals[from];
+                               }
+                               if (!m_input.colors.empty()) {
+                                   out.colors[i] = m_input.colors[from];
+                               }
+                               if (!m_input.intensities.empty()) {
+                                   out.intensities[i] = m_input.intensities[from];
+                               }
+                           }
+                       });
+                   cloud.publish(chunkBegin[c + 1]);
+                   return c;
+               }) &
+               tbb::make_filter<std::size_t, void>(
+                   tbb::filter_mode::serial_in_order, [&](std::size_t c) {
+                       for (std::size_t begin = chunkBegin[c]; begin < chunkBegin[c + 1];) {
+                           if (cancelled()) {
+                               return;
+                           }
+                           const std::size_t end =
+                               std::min(chunkBegin[c + 1], begin + m_options.batchPoints);
+                           if (m_firstRangeSeconds < 0.0) {
+                               m_firstRangeSeconds = secondsSince(start);
+                           }
+                           consumer(cloud, begin, end);
+                           begin = end;
+                       }
+                       ++chunksDone;
+                   }));
+    if (!cancelled() && static_cast<std::size_t>(chunksDone) == chunks) {
+        cloud.markComplete();
+    }
+    return chunksDone;
+}
+
+SortSummary sortPointCloud(PointReader& reader, const SortOptions& options,
+                           const SortedRangeConsumer& consumer,
+                           std::function<void(const IncrementalMortonSorter&)> onSorterReady) {
+    SortSummary summary;
+    IncrementalMortonSorter sorter(reader.info(), options);
+    if (onSorterReady) {
+        onSorterReady(sorter);
+    }
+    ReadOptions readOptions;
+    readOptions.batchPoints = options.batchPoints;
+    readOptions.cancel = options.cancel;
+    const auto readStart = Clock::now();
+    summary.read = reader.read([&](const PointBatch& batch) { sorter.add(batch); }, readOptions);
+    summary.readSeconds = secondsSince(readStart);
+    summary.points = sorter.pointCount();
+    if (summary.read.cancelled) {
+        summary.cancelled = true;
+        return summary;
+    }
+    const auto sortStart = Clock::now();
+    summary.chunksUsed = sorter.sortAndEmit(consumer);
+    summary.sortAfterReadSeconds = secondsSince(sortStart);
+    summary.firstRangeAfterReadSeconds = sorter.firstRangeSeconds();
+    summary.cancelled = options.cancel != nullptr && options.cancel->load();
+    return summary;
+}
+
+} // namespace omicron

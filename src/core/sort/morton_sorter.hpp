@@ -1,0 +1,119 @@
+// The incremental Morton sorter (the paper's pipeline 1): unsorted points in, a growing
+// sorted prefix out, so rendering can start long before the whole cloud is sorted.
+//
+// While the input is read, add() computes each point's level-21 Morton code and drops
+// (code, index) into one of 4096 bins by the code's top 12 bits: the counting pass and the
+// first distribution are done as the data arrives. After the read the bins are grouped into K
+// contiguous chunks of about equal point counts ("sort chunks"), and chunk after chunk is
+// radix sorted (all cores) and copied into the SortedCloud, whose prefix is then published and
+// handed to the consumer in batches — while the next chunk is already being sorted. The
+// output is the stable Morton order of the input: identical for any K and thread count.
+#pragma once
+
+#include "io/point_reader.hpp"
+#include "points/sorted_cloud.hpp"
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+namespace omicron {
+
+// Measured with bench/sort_bench (see README): enough chunks that the first sorted batch
+// arrives a small fraction of a full sort after reading ends, few enough that per-chunk
+// overhead stays negligible.
+inline constexpr int kDefaultSortChunks = 32;
+inline constexpr int kMaxSortChunks = 256;
+
+struct SortOptions {
+    int chunks = kDefaultSortChunks;                  // 1..256
+    std::size_t batchPoints = std::size_t{1} << 16;   // largest range handed to the consumer
+    std::size_t previewPoints = std::size_t{1} << 16; // size of the random preview sample
+    std::uint64_t previewSeed = 0x9e3779b97f4a7c15ull;
+    const std::atomic<bool>* cancel = nullptr;        // checked between chunks and batches
+    PointStorage storage = PointStorage::Exact;       // how the sorted cloud keeps its points
+};
+
+// A uniform random subsample of the points added so far (positions in the unit cube).
+struct PreviewSample {
+    std::vector<glm::vec3> positions;
+    std::vector<glm::u8vec3> colors; // empty when the cloud has no colour
+    std::uint64_t pointsSeen = 0;
+};
+
+// Receives [begin, end) of `cloud`, already published: every code in it is >= every code of
+// the ranges before. Called in order, on the thread that runs sortAndEmit().
+using SortedRangeConsumer =
+    std::function<void(const SortedCloud& cloud, std::size_t begin, std::size_t end)>;
+
+class IncrementalMortonSorter {
+public:
+    // `info` of the reader that will feed add(); throws std::length_error beyond 2^32-1 points.
+    IncrementalMortonSorter(const CloudInfo& info, const SortOptions& options);
+
+    // Reading phase (one thread): appends a batch in the unit cube of info.cube.
+    void add(const PointBatch& batch);
+
+    // Any thread, any time: a copy of the current preview sample (bounded size).
+    PreviewSample preview() const;
+
+    std::uint64_t pointCount() const { return m_input.size(); }
+    std::shared_ptr<const SortedCloud> cloud() const { return m_cloud; }
+
+    // Sorting phase: sorts chunk after chunk and calls `consumer` for every sorted range, in
+    // Morton order. Returns the number of chunks used (<= options.chunks; 0 if cancelled
+    // before the first). Call once, after the last add().
+    int sortAndEmit(const SortedRangeConsumer& consumer);
+
+    // Seconds from the start of sortAndEmit() to the first consumer call (-1 before it).
+    double firstRangeSeconds() const { return m_firstRangeSeconds; }
+
+private:
+    static constexpr int kBinBits = 12;
+    static constexpr std::size_t kBins = std::size_t{1} << kBinBits;
+
+    struct Bin {
+        std::vector<std::uint64_t> codes;
+        std::vector<std::uint32_t> indices;
+    };
+
+    void samplePreview(const PointBatch& batch, std::uint64_t firstIndex);
+    std::vector<std::size_t> chunkBinBoundaries() const;
+
+    CloudInfo m_info;
+    SortOptions m_options;
+    std::shared_ptr<SortedCloud> m_cloud;
+
+    // Input in arrival order (attributes are gathered from here into the sorted cloud).
+    PointBatch m_input;
+    std::vector<Bin> m_bins;
+    std::vector<morton::Code> m_batchCodes; // scratch for add()
+
+    mutable std::mutex m_previewMutex;
+    PreviewSample m_preview;
+
+    double m_firstRangeSeconds = -1.0;
+};
+
+struct SortSummary {
+    ReadSummary read;
+    std::uint64_t points = 0;
+    int chunksUsed = 0;
+    double readSeconds = 0.0;             // open excluded: streaming the points into the sorter
+    double firstRangeAfterReadSeconds = -1.0;
+    double sortAfterReadSeconds = 0.0;    // read end -> last range handed to the consumer
+    bool cancelled = false;
+};
+
+// Pipeline 1 in one call: reads every point of `reader` into a sorter and emits the sorted
+// ranges. `onSorterReady`, when given, is called with the sorter as soon as it exists (before
+// the read), so the caller can keep its cloud() and let another thread show its preview.
+SortSummary sortPointCloud(PointReader& reader, const SortOptions& options,
+                           const SortedRangeConsumer& consumer,
+                           std::function<void(const IncrementalMortonSorter&)> onSorterReady = {});
+
+} // namespace omicron

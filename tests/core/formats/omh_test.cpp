@@ -1,0 +1,434 @@
+// The .omh hierarchy file: bit-exact round trips of built hierarchies, the progressive
+// level-by-level load, and detection of every damaged or truncated section.
+#include "formats/omh_reader.hpp"
+#include "formats/omh_writer.hpp"
+#include "hierarchy_test_support.hpp"
+#include "io/input_error.hpp"
+#include "test_files.hpp"
+
+#include <atomic>
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <thread>
+#include <unistd.h>
+
+namespace omicron::test {
+namespace {
+
+BuildOptions options(int depth, LeafCollapse collapse) {
+    BuildOptions o;
+    o.maxLevel = depth;
+    o.collapse = collapse;
+    return o;
+}
+
+void save(const std::string& path, const BuildResult& built) {
+    writeOmh(path, built.builder->hierarchy(),
+             omhBuildInfo(built.builder->options(), built.builder->statistics()));
+}
+
+std::shared_ptr<const Hierarchy> loadAll(const std::string& path) {
+    OmhReader reader(path);
+    auto hierarchy = reader.hierarchy();
+    reader.load();
+    return hierarchy;
+}
+
+template <typename T> bool sameBytes(const T& a, const T& b) {
+    return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+
+// Everything a renderer reads, node by node and held point by held point, bit for bit.
+void expectSameHierarchy(const Hierarchy& built, const Hierarchy& loaded) {
+    ASSERT_EQ(built.maxLevel(), loaded.maxLevel());
+    const SortedCloud& a = built.cloud();
+    const SortedCloud& b = loaded.cloud();
+    ASSERT_EQ(a.attributes(), b.attributes());
+    EXPECT_EQ(b.order(), CloudOrder::NodeOrder);
+    EXPECT_TRUE(sameBytes(a.cube(), b.cube()));
+    EXPECT_TRUE(sameBytes(a.sourceOffset(), b.sourceOffset()));
+    EXPECT_TRUE(loaded.publishedCut().complete);
+    EXPECT_TRUE(b.complete());
+    std::uint32_t nextLoadedPoint = 0;
+    NodeSplats builtSplats, loadedSplats;
+    SplatScratch scratch;
+    for (int level = 0; level <= built.maxLevel(); ++level) {
+        ASSERT_EQ(built.nodeCount(level), loaded.nodeCount(level)) << "level " << level;
+        for (std::size_t i = 0; i < built.nodeCount(level); ++i) {
+            const OctreeNode& x = built.node(level, i);
+            const OctreeNode& y = loaded.node(level, i);
+            ASSERT_EQ(x.code, y.code);
+            ASSERT_EQ(x.pointCount, y.pointCount);
+            ASSERT_EQ(x.firstChild, y.firstChild);
+            ASSERT_EQ(x.childCount, y.childCount);
+            ASSERT_EQ(x.flags, y.flags);
+            ASSERT_TRUE(sameBytes(x.splatScale, y.splatScale));
+            ASSERT_TRUE(y.holdsRange());
+            ASSERT_EQ(y.coveredBegin, nextLoadedPoint) << "nodes hold consecutive ranges";
+            ASSERT_EQ(y.coveredCount, y.pointCount);
+            nextLoadedPoint += y.pointCount;
+            // The file stores the built hierarchy's estimates: the loaded node reads them back.
+            built.nodeSplats(x, builtSplats, scratch);
+            loaded.nodeSplats(y, loadedSplats, scratch);
+            ASSERT_EQ(builtSplats.radii, loadedSplats.radii);
+            ASSERT_EQ(builtSplats.normals, loadedSplats.normals);
+            for (std::uint32_t p = 0; p < x.pointCount; ++p) {
+                const std::uint32_t u = x.heldPoint(p), v = y.heldPoint(p);
+                ASSERT_TRUE(sameBytes(a.positions()[u], b.positions()[v]));
+                ASSERT_EQ(a.code(u), b.code(v));
+                if (a.attributes().has(Attribute::Normal)) {
+                    ASSERT_TRUE(sameBytes(a.normals()[u], b.normals()[v]));
+                }
+                if (a.attributes().has(Attribute::Color)) {
+                    ASSERT_EQ(a.colors()[u], b.colors()[v]);
+                }
+                if (a.attributes().has(Attribute::Intensity)) {
+                    ASSERT_EQ(a.intensities()[u], b.intensities()[v]);
+                }
+            }
+        }
+    }
+    EXPECT_EQ(b.sortedEnd(), nextLoadedPoint);
+}
+
+// Build, save, load, compare, save again: the second file must equal the first.
+void expectRoundTrip(const BuildResult& built, const TempDir& dir) {
+    const std::string first = dir.file("first.omh");
+    const std::string second = dir.file("second.omh");
+    save(first, built);
+    OmhReader reader(first);
+    const auto loaded = reader.hierarchy();
+    reader.load();
+    ASSERT_NO_FATAL_FAILURE(expectSameHierarchy(built.builder->hierarchy(), *loaded));
+    const BuildStatistics stats = built.builder->statistics();
+    const omh::Header& header = reader.header();
+    EXPECT_EQ(header.build.inputPoints, stats.inputPoints);
+    EXPECT_EQ(header.build.droppedPoints, stats.droppedPoints);
+    EXPECT_EQ(header.build.collapse, built.builder->options().collapse);
+    for (std::size_t level = 0; level < stats.levels.size(); ++level) {
+        EXPECT_EQ(header.levels[level].nodes, stats.levels[level].nodes);
+        EXPECT_EQ(header.levels[level].leaves, stats.levels[level].leaves);
+        EXPECT_EQ(header.levels[level].points, stats.levels[level].points);
+    }
+    writeOmh(second, *loaded, header.build);
+    EXPECT_EQ(readBytes(first), readBytes(second)) << "loading and saving again changed bytes";
+}
+
+// ---- Round trips ----
+
+class OmhSharedFileRoundTrip : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(OmhSharedFileRoundTrip, EveryCollapseModeIsBitExact) {
+    OMICRON_REQUIRE_SHARED_FILE(path, GetParam());
+    TempDir dir;
+    for (LeafCollapse collapse : {LeafCollapse::Off, LeafCollapse::Lossless, LeafCollapse::Paper}) {
+        SCOPED_TRACE(toString(collapse));
+        const BuildResult built = buildFile(path, options(7, collapse));
+        expectRoundTrip(built, dir);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(SharedData, OmhSharedFileRoundTrip,
+                         ::testing::Values("bunny.ply", "dragon.ply", "lion.ply", "indoor.ply",
+                                           "sorvilier.ply", "autzen_trim.ply", "autzen_trim.las"));
+
+// 4.8M points: one mode at a small depth keeps the suite fast on two cores.
+TEST(OmhRoundTrip, AutzenSouthAtDepthFiveIsBitExact) {
+    OMICRON_REQUIRE_SHARED_FILE(path, "autzen_south.ply");
+    TempDir dir;
+    expectRoundTrip(buildFile(path, options(5, LeafCollapse::Paper)), dir);
+}
+
+TEST(OmhRoundTrip, SyntheticShapesInEveryModeAreBitExact) {
+    TempDir dir;
+    for (Shape shape : {Shape::Random, Shape::SinglePoint, Shape::AllIdentical, Shape::TwoClusters,
+                        Shape::MaxFaces, Shape::Duplicates, Shape::Plane, Shape::Line}) {
+        for (LeafCollapse collapse :
+             {LeafCollapse::Off, LeafCollapse::Lossless, LeafCollapse::Paper}) {
+            for (bool normals : {false, true}) {
+                SCOPED_TRACE(std::string(toString(shape)) + ", " + toString(collapse) +
+                             (normals ? ", normals" : ""));
+                const BuildResult built =
+                    buildSynthetic(makeCloud(shape, 3000, 7, normals), options(4, collapse));
+                expectRoundTrip(built, dir);
+            }
+        }
+    }
+}
+
+TEST(OmhWriter, RefusesAnIncompleteHierarchyAndLeavesNothingBehind) {
+    TempDir dir;
+    const auto cloud =
+        std::make_shared<SortedCloud>(CubeTransform{}, glm::dvec3(0.0), AttributeSet{}, 10);
+    Hierarchy hierarchy(cloud, 3);
+    omh::BuildInfo build;
+    build.maxLevel = 3;
+    EXPECT_THROW(writeOmh(dir.file("a.omh"), hierarchy, build), OutputError);
+    EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
+}
+
+// ---- Progressive load ----
+
+TEST(OmhProgressiveLoad, LevelsArriveTopDownWhileAReaderWalksTheHierarchy) {
+    TempDir dir;
+    const BuildResult built =
+        buildSynthetic(makeCloud(Shape::Random, 40000, 3), options(6, LeafCollapse::Off));
+    const std::string path = dir.file("p.omh");
+    save(path, built);
+
+    OmhReader reader(path);
+    const auto hierarchy = reader.hierarchy();
+    std::vector<int> levels;
+    std::atomic<bool> done{false};
+    std::string readerProblem;
+    // A front as the renderer runs it: from the root, into published children only.
+    std::thread front([&] {
+        while (!done.load()) {
+            if (hierarchy->nodeCount(0) == 0) {
+                continue;
+            }
+            if (!hierarchy->publishedCut().complete) {
+                readerProblem = "level 0 published before the hierarchy was marked complete";
+            }
+            for (int level = 0; level < hierarchy->maxLevel(); ++level) {
+                // Deeper first: a level seen published implies its parents are (acquire).
+                const std::size_t nextCount = hierarchy->nodeCount(level + 1);
+                const std::size_t count = hierarchy->nodeCount(level);
+                const std::size_t cloudEnd = hierarchy->cloud().sortedEnd();
+                for (std::size_t i = 0; i < count; ++i) {
+                    const OctreeNode& node = hierarchy->node(level, i);
+                    if (node.coveredBegin + node.pointCount > cloudEnd) {
+                        readerProblem = "a published node's points are not published";
+                    }
+                    if (nextCount > 0 && node.firstChild + node.childCount > nextCount) {
+                        readerProblem = "a level was published before all of its nodes";
+                    }
+                }
+                if (count == 0 && nextCount != 0) {
+                    readerProblem = "a level was published before its parents";
+                }
+            }
+        }
+    });
+    reader.load([&](int level) { levels.push_back(level); });
+    done.store(true);
+    front.join();
+    EXPECT_EQ(readerProblem, "");
+    EXPECT_EQ(levels, (std::vector<int>{0, 1, 2, 3, 4, 5, 6}));
+    expectSameHierarchy(built.builder->hierarchy(), *hierarchy);
+}
+
+TEST(OmhProgressiveLoad, CancelStopsBetweenLevels) {
+    TempDir dir;
+    const std::string path = dir.file("c.omh");
+    save(path, buildSynthetic(makeCloud(Shape::Random, 5000, 5), options(5, LeafCollapse::Off)));
+    OmhReader reader(path);
+    const auto hierarchy = reader.hierarchy();
+    std::atomic<bool> cancel{false};
+    reader.load([&](int level) { cancel.store(level == 2); }, &cancel);
+    EXPECT_GT(hierarchy->nodeCount(2), 0u);
+    EXPECT_EQ(hierarchy->nodeCount(3), 0u);
+    EXPECT_FALSE(hierarchy->cloud().complete());
+}
+
+// ---- Damage ----
+
+// A small file whose every section is present (a few KiB, so flipping each byte stays fast).
+struct SmallFile {
+    TempDir dir;
+    std::string path = dir.file("small.omh");
+    std::vector<std::uint8_t> bytes;
+    omh::Header header;
+
+    SmallFile() {
+        save(path, buildSynthetic(makeCloud(Shape::Random, 60, 11), options(2, LeafCollapse::Off)));
+        bytes = readBytes(path);
+        header = OmhReader(path).header();
+    }
+
+    // The words an error about byte `offset` must contain.
+    std::string sectionName(std::uint64_t offset) const {
+        if (offset < omh::kHeaderBytes) {
+            return "header";
+        }
+        if (offset < header.nodeTableOffset()) {
+            return "level table";
+        }
+        if (offset >= header.footerOffset()) {
+            return "footer";
+        }
+        for (std::size_t l = header.levels.size(); l-- > 0;) {
+            if (offset >= header.levels[l].payloadOffset) {
+                return "point records of level " + std::to_string(l);
+            }
+        }
+        for (std::size_t l = header.levels.size(); l-- > 0;) {
+            if (offset >= header.levels[l].nodeTableOffset) {
+                return "node table of level " + std::to_string(l);
+            }
+        }
+        return "?";
+    }
+};
+
+// Opens and loads `path`; the InputError's message, or "" when nothing was detected.
+std::string loadError(const std::string& path) {
+    try {
+        OmhReader reader(path);
+        reader.load();
+    } catch (const InputError& error) {
+        return error.what();
+    }
+    return "";
+}
+
+TEST(OmhDamage, EveryByteFlipIsDetectedAndNamesTheSection) {
+    SmallFile file;
+    ASSERT_GT(file.header.levels[2].points, 0u);
+    const std::string damaged = file.dir.file("damaged.omh");
+    for (std::size_t at = 0; at < file.bytes.size(); ++at) {
+        std::vector<std::uint8_t> bytes = file.bytes;
+        bytes[at] ^= 0x5a;
+        writeBytes(damaged, bytes);
+        const std::string message = loadError(damaged);
+        ASSERT_NE(message, "") << "flip at byte " << at << " went unnoticed";
+        ASSERT_NE(message.find(damaged), std::string::npos) << message;
+        ASSERT_NE(message.find(file.sectionName(at)), std::string::npos)
+            << "byte " << at << ": " << message;
+    }
+}
+
+TEST(OmhDamage, VerifyFindsAFlipThatOpeningDoesNotRead) {
+    SmallFile file;
+    std::vector<std::uint8_t> bytes = file.bytes;
+    bytes[file.header.levels[2].payloadOffset + 1] ^= 1;
+    writeBytes(file.path, bytes);
+    OmhReader reader(file.path); // header, level table and footer are intact
+    try {
+        reader.verify();
+        FAIL() << "verify() missed the damaged point records";
+    } catch (const InputError& error) {
+        EXPECT_NE(std::string(error.what()).find("point records of level 2"), std::string::npos)
+            << error.what();
+    }
+}
+
+TEST(OmhDamage, TruncationAtEverySectionBoundaryIsAClearError) {
+    SmallFile file;
+    std::vector<std::uint64_t> boundaries{1, omh::kHeaderBytes, file.header.nodeTableOffset(),
+                                          file.header.footerOffset(), file.bytes.size() - 1};
+    for (const omh::LevelEntry& level : file.header.levels) {
+        boundaries.push_back(level.nodeTableOffset);
+        boundaries.push_back(level.payloadOffset);
+    }
+    const std::string cut = file.dir.file("cut.omh");
+    for (std::uint64_t size : boundaries) {
+        writeBytes(cut, std::vector<std::uint8_t>(file.bytes.begin(), file.bytes.begin() + size));
+        try {
+            OmhReader reader(cut);
+            FAIL() << "a file cut at byte " << size << " opened";
+        } catch (const InputError& error) {
+            const std::string message = error.what();
+            EXPECT_EQ(error.kind(), InputErrorKind::Truncated) << message;
+            EXPECT_NE(message.find(cut), std::string::npos) << message;
+            EXPECT_NE(message.find(file.sectionName(size)), std::string::npos)
+                << "cut at " << size << ": " << message;
+        }
+    }
+    writeBytes(cut, {});
+    try {
+        OmhReader reader(cut);
+        FAIL() << "an empty file opened";
+    } catch (const InputError& error) {
+        EXPECT_EQ(error.kind(), InputErrorKind::EmptyFile);
+    }
+}
+
+TEST(OmhDamage, TrailingBytesAreACountMismatch) {
+    SmallFile file;
+    std::vector<std::uint8_t> bytes = file.bytes;
+    bytes.push_back(0);
+    writeBytes(file.path, bytes);
+    try {
+        OmhReader reader(file.path);
+        FAIL();
+    } catch (const InputError& error) {
+        EXPECT_EQ(error.kind(), InputErrorKind::CountMismatch) << error.what();
+    }
+}
+
+// ---- Safe save ----
+
+TEST(OmhSafeSave, AFailedWriteKeepsTheOldFileAndLeavesNoTemporary) {
+    TempDir dir;
+    const std::string path = dir.file("keep.omh");
+    const BuildResult small =
+        buildSynthetic(makeCloud(Shape::Random, 500, 1), options(3, LeafCollapse::Off));
+    save(path, small);
+    const std::vector<std::uint8_t> before = readBytes(path);
+    const BuildResult large =
+        buildSynthetic(makeCloud(Shape::Random, 200000, 2), options(6, LeafCollapse::Off));
+
+    // A file size limit makes write() fail with EFBIG part way, as a full disk fails it with
+    // ENOSPC: the same error path.
+    rlimit previous{};
+    ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &previous), 0);
+    const auto previousHandler = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit limited = previous;
+    limited.rlim_cur = 1 << 20;
+    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limited), 0);
+    std::string message;
+    try {
+        save(path, large);
+    } catch (const OutputError& error) {
+        message = error.what();
+    }
+    setrlimit(RLIMIT_FSIZE, &previous);
+    std::signal(SIGXFSZ, previousHandler);
+
+    EXPECT_NE(message.find(path), std::string::npos) << "the error names the file: " << message;
+    EXPECT_EQ(readBytes(path), before);
+    std::size_t files = 0;
+    for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+        ++files;
+    }
+    EXPECT_EQ(files, 1u) << "no temporary file is left behind";
+    EXPECT_NO_THROW(loadAll(path));
+}
+
+TEST(OmhSafeSave, AMissingOrUnwritableFolderIsAnOutputErrorNamingTheFile) {
+    TempDir dir;
+    const BuildResult built =
+        buildSynthetic(makeCloud(Shape::Random, 100, 1), options(2, LeafCollapse::Off));
+    const std::string missing = dir.file("no-such-folder/a.omh");
+    try {
+        save(missing, built);
+        FAIL();
+    } catch (const OutputError& error) {
+        EXPECT_NE(std::string(error.what()).find(missing), std::string::npos);
+    }
+    if (geteuid() != 0) { // root writes into read-only folders
+        const std::filesystem::path locked = dir.path() / "locked";
+        std::filesystem::create_directory(locked);
+        std::filesystem::permissions(locked, std::filesystem::perms::owner_read |
+                                                 std::filesystem::perms::owner_exec);
+        EXPECT_THROW(save((locked / "a.omh").string(), built), OutputError);
+        std::filesystem::permissions(locked, std::filesystem::perms::owner_all);
+    }
+}
+
+TEST(OmhDetection, IsOmhFileChecksTheMagicOrTheExtension) {
+    SmallFile file;
+    const std::string renamed = file.dir.file("hierarchy.bin");
+    std::filesystem::copy_file(file.path, renamed);
+    EXPECT_TRUE(isOmhFile(file.path));
+    EXPECT_TRUE(isOmhFile(renamed));
+    EXPECT_TRUE(isOmhFile(file.dir.file("missing.OMH")));
+    EXPECT_FALSE(isOmhFile(file.dir.file("missing.ply")));
+}
+
+} // namespace
+} // namespace omicron::test

@@ -1,0 +1,3 @@
+// Fixture: an include without its folder.
+#pragma once
+#include "sorter_impl.hpp"

@@ -1,0 +1,3 @@
+// Fixture: the core reaching into the widget.
+#pragma once
+#include "widget/cloud_view.hpp"

@@ -1,0 +1,3 @@
+// Fixture: OpenGL through Qt in the core.
+#pragma once
+#include <QOpenGLFunctions>

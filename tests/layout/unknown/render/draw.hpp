@@ -1,0 +1,3 @@
+// Fixture: a folder the rules do not know.
+#pragma once
+#include <vector>

@@ -1,0 +1,3 @@
+// Fixture: an allowed include (build may use points).
+#pragma once
+#include "points/point_cloud.hpp"
