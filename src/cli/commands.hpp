@@ -1,5 +1,5 @@
 // omicron-cli's commands. main() dispatches on the first argument and maps exceptions to exit
-// statuses: UsageError -> 2, InputError/OutputError -> 1.
+// statuses: UsageError -> 2, InputError/OutputError -> 1, Interrupted (Ctrl+C) -> 130.
 #pragma once
 
 #include <string>
@@ -23,6 +23,7 @@ const Command& buildCommand();
 const Command& renderCommand();
 const Command& convertCommand();
 const Command& exportPotreeCommand();
+const Command& tileCommand();
 
 // Prints "usage: omicron-cli USAGE" and the help text to stdout (for --help).
 void printCommandHelp(const Command& command);

@@ -2,6 +2,7 @@
 // statuses: 0 ok, 1 input or output error, 2 usage error.
 #include "cli_args.hpp"
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "io/atomic_file_writer.hpp"
 #include "io/input_error.hpp"
 
@@ -18,13 +19,15 @@ using omicron::cli::Command;
 
 constexpr int kExitInputOutput = 1;
 constexpr int kExitUsage = 2;
+constexpr int kExitInterrupted = 130; // 128 + SIGINT, as shells report it
 
-const std::array<const Command*, 8>& commands() {
-    static const std::array<const Command*, 8> all{
+const std::array<const Command*, 9>& commands() {
+    static const std::array<const Command*, 9> all{
         &omicron::cli::infoCommand(),    &omicron::cli::generateCommand(),
         &omicron::cli::sortCommand(),    &omicron::cli::exportCommand(),
         &omicron::cli::buildCommand(),   &omicron::cli::convertCommand(),
-        &omicron::cli::exportPotreeCommand(), &omicron::cli::renderCommand()};
+        &omicron::cli::exportPotreeCommand(), &omicron::cli::renderCommand(),
+        &omicron::cli::tileCommand()};
     return all;
 }
 
@@ -34,7 +37,7 @@ void printGlobalHelp() {
         std::printf("  %-14s %s\n", command->name, command->summary);
     }
     std::printf("\n'omicron-cli COMMAND --help' describes a command.\n"
-                "Exit status: 0 ok, 1 input or output error, 2 usage error.\n");
+                "Exit status: 0 ok, 1 input or output error, 2 usage error, 130 interrupted.\n");
 }
 
 int usageFailure(const std::string& reason, const Command* command) {
@@ -79,6 +82,10 @@ int main(int argc, char** argv) {
     }
     try {
         return command->run(std::vector<std::string>(args.begin() + 1, args.end()));
+    } catch (const omicron::cli::Interrupted&) {
+        std::fprintf(stderr, "omicron-cli: %s: interrupted; no output was written\n",
+                     command->name);
+        return kExitInterrupted;
     } catch (const omicron::cli::UsageError& error) {
         return usageFailure(std::string(command->name) + ": " + error.what(), command);
     } catch (const omicron::InputError& error) {

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <sys/wait.h>
+#include <thread>
 #include <unistd.h>
 
 extern char** environ;
@@ -105,6 +106,34 @@ void RunningProcess::kill() {
     while (waitpid(m_pid, &status, 0) < 0 && errno == EINTR) {
     }
     m_pid = -1;
+}
+
+void RunningProcess::signal(int signalNumber) {
+    if (m_pid > 0) {
+        ::kill(m_pid, signalNumber);
+    }
+}
+
+std::optional<int> RunningProcess::waitFor(std::chrono::milliseconds timeout) {
+    if (m_pid <= 0) {
+        return std::nullopt;
+    }
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    for (;;) {
+        int status = 0;
+        const pid_t ended = waitpid(m_pid, &status, WNOHANG);
+        if (ended == m_pid) {
+            m_pid = -1;
+            return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        }
+        if (ended < 0 && errno != EINTR) {
+            return std::nullopt;
+        }
+        if (std::chrono::steady_clock::now() >= deadline) {
+            return std::nullopt;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
 }
 
 } // namespace omicron::test

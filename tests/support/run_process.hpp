@@ -1,6 +1,8 @@
 // Runs a program as a real child process and captures what it prints, for CLI tests.
 #pragma once
 
+#include <chrono>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +31,11 @@ public:
 
     // Sends SIGKILL and waits for the child to end.
     void kill();
+    // Sends `signalNumber` (SIGINT is what Ctrl+C sends).
+    void signal(int signalNumber);
+    // Waits up to `timeout` for the child to end: its exit code (-1 when a signal ended it),
+    // or nothing while it still runs.
+    std::optional<int> waitFor(std::chrono::milliseconds timeout);
 
 private:
     int m_pid = -1;

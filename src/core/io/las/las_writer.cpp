@@ -42,211 +42,210 @@ std::string number(double value) {
     return text;
 }
 
-class LasFileWriter {
-public:
-    LasFileWriter(const std::string& path, const PointBatch& points, const CubeTransform& cube,
-                  const LasWriteOptions& options)
-        : m_path(path), m_points(points), m_cube(cube), m_options(options) {}
+[[noreturn]] void fail(const std::string& path, const std::string& why) {
+    throw OutputError(path + ": " + why);
+}
 
-    void write() {
-        checkOptions();
-        const Bounds quantised = quantisedBounds();
-        AtomicFileWriter file(m_path);
-        writeHeader(file, quantised);
-        writeVlrs(file);
-        writeRecords(file);
-        file.commit();
+std::uint16_t recordLength(const LasWriteOptions& options) {
+    return static_cast<std::uint16_t>(las::minimumRecordLength(options.pointFormat) +
+                                      options.extraBytesPerRecord);
+}
+
+std::uint32_t pointDataOffset(const LasWriteOptions& options) {
+    std::uint64_t offset = las::requiredHeaderSize(options.versionMinor);
+    for (const LasVariableLengthRecord& vlr : options.vlrs) {
+        offset += las::kVlrHeaderSize + vlr.payload.size();
     }
+    return static_cast<std::uint32_t>(offset);
+}
 
-private:
-    [[noreturn]] void fail(const std::string& why) const { throw OutputError(m_path + ": " + why); }
-
-    std::uint16_t recordLength() const {
-        return static_cast<std::uint16_t>(las::minimumRecordLength(m_options.pointFormat) +
-                                          m_options.extraBytesPerRecord);
+void checkOptions(const std::string& path, const LasWriteOptions& o, std::uint64_t pointCount) {
+    if (o.versionMinor != 2 && o.versionMinor != 4) {
+        fail(path, "cannot write LAS 1." + std::to_string(o.versionMinor) +
+                       ", expected version 1.2 or 1.4");
     }
-
-    std::uint32_t pointDataOffset() const {
-        std::uint64_t offset = las::requiredHeaderSize(m_options.versionMinor);
-        for (const LasVariableLengthRecord& vlr : m_options.vlrs) {
-            offset += las::kVlrHeaderSize + vlr.payload.size();
-        }
-        return static_cast<std::uint32_t>(offset);
+    if (o.pointFormat > las::kMaxPointFormat) {
+        fail(path, "unknown LAS point format " + std::to_string(o.pointFormat) +
+                       ", expected 0 to 10");
     }
-
-    void checkOptions() const {
-        const LasWriteOptions& o = m_options;
-        if (o.versionMinor != 2 && o.versionMinor != 4) {
-            fail("cannot write LAS 1." + std::to_string(o.versionMinor) +
-                 ", expected version 1.2 or 1.4");
+    if (o.pointFormat > 5 && o.versionMinor < 4) {
+        fail(path, "LAS point format " + std::to_string(o.pointFormat) + " needs LAS 1.4");
+    }
+    if (las::minimumRecordLength(o.pointFormat) + o.extraBytesPerRecord > 0xFFFF) {
+        fail(path, std::to_string(o.extraBytesPerRecord) +
+                       " extra bytes make the record longer than 65535 bytes");
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+        if (!std::isfinite(o.scale[axis]) || !(o.scale[axis] > 0.0)) {
+            fail(path, "LAS scale " + number(o.scale[axis]) + " is not a finite positive number");
         }
-        if (o.pointFormat > las::kMaxPointFormat) {
-            fail("unknown LAS point format " + std::to_string(o.pointFormat) +
-                 ", expected 0 to 10");
-        }
-        if (o.pointFormat > 5 && o.versionMinor < 4) {
-            fail("LAS point format " + std::to_string(o.pointFormat) + " needs LAS 1.4");
-        }
-        if (las::minimumRecordLength(o.pointFormat) + o.extraBytesPerRecord > 0xFFFF) {
-            fail(std::to_string(o.extraBytesPerRecord) +
-                 " extra bytes make the record longer than 65535 bytes");
-        }
-        for (int axis = 0; axis < 3; ++axis) {
-            if (!std::isfinite(o.scale[axis]) || !(o.scale[axis] > 0.0)) {
-                fail("LAS scale " + number(o.scale[axis]) + " is not a finite positive number");
-            }
-            if (!std::isfinite(o.offset[axis])) {
-                fail("LAS offset " + number(o.offset[axis]) + " is not finite");
-            }
-        }
-        for (const LasVariableLengthRecord& vlr : o.vlrs) {
-            if (vlr.userId.size() > 16 || vlr.description.size() > 32 ||
-                vlr.payload.size() > 0xFFFF) {
-                fail("variable length record '" + vlr.userId +
-                     "' exceeds the LAS limits (user id 16 characters, description 32, "
-                     "payload 65535 bytes)");
-            }
-        }
-        if (pointDataOffset() >= std::numeric_limits<std::uint32_t>::max()) {
-            fail("the variable length records do not fit before a 32-bit point data offset");
-        }
-        if (o.versionMinor < 4 && m_points.size() > std::numeric_limits<std::uint32_t>::max()) {
-            fail(std::to_string(m_points.size()) +
-                 " points do not fit in LAS 1.2's 32-bit point count; write LAS 1.4");
+        if (!std::isfinite(o.offset[axis])) {
+            fail(path, "LAS offset " + number(o.offset[axis]) + " is not finite");
         }
     }
-
-    // The stored integers of point `index`; checked to fit by quantisedBounds().
-    glm::dvec3 quantise(std::size_t index) const {
-        const glm::dvec3 source = m_cube.toSource(m_points.positions[index]);
-        return glm::round((source - m_options.offset) / m_options.scale);
-    }
-
-    Bounds quantisedBounds() const {
-        constexpr double lowest = std::numeric_limits<std::int32_t>::min();
-        constexpr double highest = std::numeric_limits<std::int32_t>::max();
-        Bounds steps;
-        for (std::size_t i = 0; i < m_points.size(); ++i) {
-            const glm::dvec3 q = quantise(i);
-            for (int axis = 0; axis < 3; ++axis) {
-                if (!(q[axis] >= lowest && q[axis] <= highest)) {
-                    fail("point " + std::to_string(i) +
-                         " does not fit in LAS's 32-bit integer "
-                         "coordinates with scale " +
-                         number(m_options.scale[axis]) + " and offset " +
-                         number(m_options.offset[axis]) +
-                         "; use a larger scale or an offset near the data");
-                }
-            }
-            steps.extend(q);
-        }
-        if (steps.empty()) {
-            return Bounds{glm::dvec3(0.0), glm::dvec3(0.0)};
-        }
-        return {steps.min * m_options.scale + m_options.offset,
-                steps.max * m_options.scale + m_options.offset};
-    }
-
-    void writeHeader(AtomicFileWriter& file, const Bounds& bounds) const {
-        namespace field = las::field;
-        const LasWriteOptions& o = m_options;
-        const std::uint16_t headerSize = las::requiredHeaderSize(o.versionMinor);
-        const std::uint64_t count = m_points.size();
-        std::array<std::uint8_t, las::kHeaderSize14> header{};
-        std::memcpy(&header[field::signature], "LASF", 4);
-        if (o.pointFormat > 5) {
-            store<std::uint16_t>(&header[field::globalEncoding], kGlobalEncodingWkt);
-        }
-        header[field::versionMajor] = 1;
-        header[field::versionMinor] = o.versionMinor;
-        storeText(&header[field::systemIdentifier], 32, "OTHER");
-        storeText(&header[field::generatingSoftware], 32, "omicron");
-        store<std::uint16_t>(&header[field::headerSize], headerSize);
-        store<std::uint32_t>(&header[field::pointDataOffset], pointDataOffset());
-        store<std::uint32_t>(&header[field::vlrCount], static_cast<std::uint32_t>(o.vlrs.size()));
-        header[field::pointFormat] = o.pointFormat;
-        store<std::uint16_t>(&header[field::recordLength], recordLength());
-        // LAS 1.4 leaves the legacy counts 0 for formats 6 to 10 and for counts over 2^32.
-        const bool legacyCountFits =
-            o.pointFormat <= 5 && count <= std::numeric_limits<std::uint32_t>::max();
-        if (legacyCountFits) {
-            store<std::uint32_t>(&header[field::legacyPointCount],
-                                 static_cast<std::uint32_t>(count));
-            store<std::uint32_t>(&header[field::legacyPointsByReturn],
-                                 static_cast<std::uint32_t>(count));
-        }
-        for (int axis = 0; axis < 3; ++axis) {
-            store<double>(&header[field::scale + 8 * axis], o.scale[axis]);
-            store<double>(&header[field::offset + 8 * axis], o.offset[axis]);
-            store<double>(&header[field::bounds + 16 * axis], bounds.max[axis]);
-            store<double>(&header[field::bounds + 16 * axis + 8], bounds.min[axis]);
-        }
-        if (o.versionMinor >= 4) {
-            store<std::uint64_t>(&header[field::pointCount], count);
-            store<std::uint64_t>(&header[field::pointsByReturn], count);
-        }
-        file.write(header.data(), headerSize);
-    }
-
-    void writeVlrs(AtomicFileWriter& file) const {
-        for (const LasVariableLengthRecord& vlr : m_options.vlrs) {
-            std::array<std::uint8_t, las::kVlrHeaderSize> bytes{};
-            storeText(&bytes[2], 16, vlr.userId);
-            store<std::uint16_t>(&bytes[18], vlr.recordId);
-            store<std::uint16_t>(&bytes[20], static_cast<std::uint16_t>(vlr.payload.size()));
-            storeText(&bytes[22], 32, vlr.description);
-            file.write(bytes.data(), bytes.size());
-            file.write(vlr.payload.data(), vlr.payload.size());
+    for (const LasVariableLengthRecord& vlr : o.vlrs) {
+        if (vlr.userId.size() > 16 || vlr.description.size() > 32 ||
+            vlr.payload.size() > 0xFFFF) {
+            fail(path, "variable length record '" + vlr.userId +
+                           "' exceeds the LAS limits (user id 16 characters, description 32, "
+                           "payload 65535 bytes)");
         }
     }
-
-    void writeRecords(AtomicFileWriter& file) const {
-        const std::uint8_t format = m_options.pointFormat;
-        const std::size_t stride = recordLength();
-        const bool hasIntensity = m_points.attributes.has(Attribute::Intensity);
-        const bool writesColor =
-            las::formatHasColor(format) && m_points.attributes.has(Attribute::Color);
-        const std::size_t colorAt = writesColor ? las::colorOffset(format) : 0;
-        const std::uint8_t returnBits = format > 5 ? kSingleReturn14 : kSingleReturnLegacy;
-
-        std::vector<std::uint8_t> chunk;
-        for (std::size_t first = 0; first < m_points.size(); first += kChunkRecords) {
-            const std::size_t count = std::min(kChunkRecords, m_points.size() - first);
-            chunk.assign(count * stride, 0);
-            for (std::size_t i = 0; i < count; ++i) {
-                const std::size_t index = first + i;
-                std::uint8_t* record = &chunk[i * stride];
-                const glm::dvec3 q = quantise(index);
-                store(record, static_cast<std::int32_t>(q.x));
-                store(record + 4, static_cast<std::int32_t>(q.y));
-                store(record + 8, static_cast<std::int32_t>(q.z));
-                if (hasIntensity) {
-                    store(record + las::kRecordIntensity, m_points.intensities[index]);
-                }
-                record[las::kRecordReturnBits] = returnBits;
-                if (writesColor) {
-                    const glm::u8vec3 c = m_points.colors[index];
-                    store(record + colorAt, static_cast<std::uint16_t>(c.r * 257));
-                    store(record + colorAt + 2, static_cast<std::uint16_t>(c.g * 257));
-                    store(record + colorAt + 4, static_cast<std::uint16_t>(c.b * 257));
-                }
-            }
-            file.write(chunk.data(), chunk.size());
-        }
+    if (pointDataOffset(o) >= std::numeric_limits<std::uint32_t>::max()) {
+        fail(path, "the variable length records do not fit before a 32-bit point data offset");
     }
+    if (o.versionMinor < 4 && pointCount > std::numeric_limits<std::uint32_t>::max()) {
+        fail(path, std::to_string(pointCount) +
+                       " points do not fit in LAS 1.2's 32-bit point count; write LAS 1.4");
+    }
+}
 
-    const std::string& m_path;
-    const PointBatch& m_points;
-    const CubeTransform& m_cube;
-    const LasWriteOptions& m_options;
-};
+// The public header block; `bounds` in source units (those of the quantised coordinates).
+std::vector<std::uint8_t> headerBytes(const LasWriteOptions& o, std::uint64_t count,
+                                      const Bounds& bounds) {
+    namespace field = las::field;
+    const std::uint16_t headerSize = las::requiredHeaderSize(o.versionMinor);
+    std::vector<std::uint8_t> header(las::kHeaderSize14, 0);
+    std::memcpy(&header[field::signature], "LASF", 4);
+    if (o.pointFormat > 5) {
+        store<std::uint16_t>(&header[field::globalEncoding], kGlobalEncodingWkt);
+    }
+    header[field::versionMajor] = 1;
+    header[field::versionMinor] = o.versionMinor;
+    storeText(&header[field::systemIdentifier], 32, "OTHER");
+    storeText(&header[field::generatingSoftware], 32, "omicron");
+    store<std::uint16_t>(&header[field::headerSize], headerSize);
+    store<std::uint32_t>(&header[field::pointDataOffset], pointDataOffset(o));
+    store<std::uint32_t>(&header[field::vlrCount], static_cast<std::uint32_t>(o.vlrs.size()));
+    header[field::pointFormat] = o.pointFormat;
+    store<std::uint16_t>(&header[field::recordLength], recordLength(o));
+    // LAS 1.4 leaves the legacy counts 0 for formats 6 to 10 and for counts over 2^32.
+    const bool legacyCountFits =
+        o.pointFormat <= 5 && count <= std::numeric_limits<std::uint32_t>::max();
+    if (legacyCountFits) {
+        store<std::uint32_t>(&header[field::legacyPointCount], static_cast<std::uint32_t>(count));
+        store<std::uint32_t>(&header[field::legacyPointsByReturn],
+                             static_cast<std::uint32_t>(count));
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+        store<double>(&header[field::scale + 8 * axis], o.scale[axis]);
+        store<double>(&header[field::offset + 8 * axis], o.offset[axis]);
+        store<double>(&header[field::bounds + 16 * axis], bounds.max[axis]);
+        store<double>(&header[field::bounds + 16 * axis + 8], bounds.min[axis]);
+    }
+    if (o.versionMinor >= 4) {
+        store<std::uint64_t>(&header[field::pointCount], count);
+        store<std::uint64_t>(&header[field::pointsByReturn], count);
+    }
+    header.resize(headerSize);
+    return header;
+}
+
+void writeVlrs(AtomicFileWriter& file, const LasWriteOptions& options) {
+    for (const LasVariableLengthRecord& vlr : options.vlrs) {
+        std::array<std::uint8_t, las::kVlrHeaderSize> bytes{};
+        storeText(&bytes[2], 16, vlr.userId);
+        store<std::uint16_t>(&bytes[18], vlr.recordId);
+        store<std::uint16_t>(&bytes[20], static_cast<std::uint16_t>(vlr.payload.size()));
+        storeText(&bytes[22], 32, vlr.description);
+        file.write(bytes.data(), bytes.size());
+        file.write(vlr.payload.data(), vlr.payload.size());
+    }
+}
 
 } // namespace
 
+LasStreamWriter::LasStreamWriter(const std::string& path, std::uint64_t pointCount,
+                                 AttributeSet attributes, const LasWriteOptions& options)
+    : m_options(options), m_attributes(attributes), m_pointCount(pointCount) {
+    checkOptions(path, options, pointCount);
+    m_file.emplace(path);
+    // The bounds are known at finish(), which writes the header again.
+    const std::vector<std::uint8_t> header = headerBytes(m_options, m_pointCount, Bounds{});
+    m_file->write(header.data(), header.size());
+    writeVlrs(*m_file, m_options);
+}
+
+void LasStreamWriter::append(const PointBatch& points, const CubeTransform& cube) {
+    assert(points.consistent());
+    const std::string& path = m_file->targetPath();
+    if (points.attributes != m_attributes) {
+        fail(path, "a batch's attributes differ from those the writer was opened with");
+    }
+    if (points.size() > m_pointCount - m_pointsWritten) {
+        fail(path, std::to_string(m_pointsWritten + points.size()) +
+                       " points appended, but the header declares " +
+                       std::to_string(m_pointCount));
+    }
+    const std::uint8_t format = m_options.pointFormat;
+    const std::size_t stride = recordLength(m_options);
+    const bool hasIntensity = points.attributes.has(Attribute::Intensity);
+    const bool writesColor = las::formatHasColor(format) && points.attributes.has(Attribute::Color);
+    const std::size_t colorAt = writesColor ? las::colorOffset(format) : 0;
+    const std::uint8_t returnBits = format > 5 ? kSingleReturn14 : kSingleReturnLegacy;
+    constexpr double lowest = std::numeric_limits<std::int32_t>::min();
+    constexpr double highest = std::numeric_limits<std::int32_t>::max();
+
+    for (std::size_t first = 0; first < points.size(); first += kChunkRecords) {
+        const std::size_t count = std::min(kChunkRecords, points.size() - first);
+        m_chunk.assign(count * stride, 0);
+        for (std::size_t i = 0; i < count; ++i) {
+            const std::size_t index = first + i;
+            std::uint8_t* record = &m_chunk[i * stride];
+            const glm::dvec3 source = cube.toSource(points.positions[index]);
+            const glm::dvec3 q = glm::round((source - m_options.offset) / m_options.scale);
+            for (int axis = 0; axis < 3; ++axis) {
+                if (!(q[axis] >= lowest && q[axis] <= highest)) {
+                    fail(path, "point " + std::to_string(m_pointsWritten + index) +
+                                   " does not fit in LAS's 32-bit integer coordinates with "
+                                   "scale " +
+                                   number(m_options.scale[axis]) + " and offset " +
+                                   number(m_options.offset[axis]) +
+                                   "; use a larger scale or an offset near the data");
+                }
+            }
+            m_steps.extend(q);
+            store(record, static_cast<std::int32_t>(q.x));
+            store(record + 4, static_cast<std::int32_t>(q.y));
+            store(record + 8, static_cast<std::int32_t>(q.z));
+            if (hasIntensity) {
+                store(record + las::kRecordIntensity, points.intensities[index]);
+            }
+            record[las::kRecordReturnBits] = returnBits;
+            if (writesColor) {
+                const glm::u8vec3 c = points.colors[index];
+                store(record + colorAt, static_cast<std::uint16_t>(c.r * 257));
+                store(record + colorAt + 2, static_cast<std::uint16_t>(c.g * 257));
+                store(record + colorAt + 4, static_cast<std::uint16_t>(c.b * 257));
+            }
+        }
+        m_file->write(m_chunk.data(), m_chunk.size());
+    }
+    m_pointsWritten += points.size();
+}
+
+void LasStreamWriter::finish() {
+    if (m_pointsWritten != m_pointCount) {
+        fail(m_file->targetPath(), "only " + std::to_string(m_pointsWritten) +
+                                       " points appended, but the header declares " +
+                                       std::to_string(m_pointCount));
+    }
+    // The header's bounds are those of the quantised coordinates, so a reader's check
+    // against them is exact.
+    const Bounds bounds = m_steps.empty()
+                              ? Bounds{glm::dvec3(0.0), glm::dvec3(0.0)}
+                              : Bounds{m_steps.min * m_options.scale + m_options.offset,
+                                       m_steps.max * m_options.scale + m_options.offset};
+    const std::vector<std::uint8_t> header = headerBytes(m_options, m_pointCount, bounds);
+    m_file->writeAt(0, header.data(), header.size());
+    m_file->commit();
+}
+
 void writeLas(const std::string& path, const PointBatch& points, const CubeTransform& cube,
               const LasWriteOptions& options) {
-    assert(points.consistent());
-    LasFileWriter(path, points, cube, options).write();
+    LasStreamWriter writer(path, points.size(), points.attributes, options);
+    writer.append(points, cube);
+    writer.finish();
 }
 
 } // namespace omicron

@@ -1,12 +1,14 @@
-// Writes a point batch as uncompressed LAS 1.2 or 1.4, atomically.
+// Writes points as uncompressed LAS 1.2 or 1.4, atomically: a whole batch, or streamed.
 #pragma once
 
 #include "io/atomic_file_writer.hpp"
+#include "points/bounds.hpp"
 #include "points/cube_transform.hpp"
 #include "points/point_batch.hpp"
 
 #include <cstdint>
 #include <glm/vec3.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +31,32 @@ struct LasWriteOptions {
     glm::dvec3 offset{0.0};
     std::uint16_t extraBytesPerRecord = 0; // zeros after each record's standard fields
     std::vector<LasVariableLengthRecord> vlrs;
+};
+
+// A LAS file written in pieces, so memory stays bounded whatever the count: the options are
+// checked and the header (with the count) written when constructed, the records batch after
+// batch, and finish() writes the header's bounds (those of the quantised coordinates) and
+// commits, only when exactly `pointCount` points were appended. Destroyed without finish()
+// (an error, a cancel), the target is untouched and the temporary removed. Fields as
+// writeLas below. Throws OutputError.
+class LasStreamWriter {
+public:
+    LasStreamWriter(const std::string& path, std::uint64_t pointCount, AttributeSet attributes,
+                    const LasWriteOptions& options = {});
+    // Appends every point of `points` (positions mapped to source units with `cube`); its
+    // attributes must be the declared ones.
+    void append(const PointBatch& points, const CubeTransform& cube);
+    void finish();
+    std::uint64_t pointsWritten() const { return m_pointsWritten; }
+
+private:
+    LasWriteOptions m_options;
+    AttributeSet m_attributes;
+    std::uint64_t m_pointCount;
+    std::uint64_t m_pointsWritten = 0;
+    Bounds m_steps; // of the stored integers
+    std::vector<std::uint8_t> m_chunk;
+    std::optional<AtomicFileWriter> m_file; // opened once the options are checked
 };
 
 // Writes every point of `points` (positions mapped back to source units with `cube`). The

@@ -36,7 +36,8 @@ std::string singleLine(std::string text) {
     return text;
 }
 
-std::string headerText(const PointBatch& points, const PlyWriteOptions& options) {
+std::string headerText(std::uint64_t pointCount, AttributeSet attributes,
+                       const PlyWriteOptions& options) {
     std::string header = "ply\nformat ";
     header += encodingName(options.encoding);
     header += " 1.0\n";
@@ -50,15 +51,15 @@ std::string headerText(const PointBatch& points, const PlyWriteOptions& options)
     for (const std::string& comment : options.comments) {
         header += "comment " + singleLine(comment) + "\n";
     }
-    header += "element vertex " + std::to_string(points.size()) + "\n";
+    header += "element vertex " + std::to_string(pointCount) + "\n";
     header += "property float x\nproperty float y\nproperty float z\n";
-    if (points.attributes.has(Attribute::Normal)) {
+    if (attributes.has(Attribute::Normal)) {
         header += "property float nx\nproperty float ny\nproperty float nz\n";
     }
-    if (points.attributes.has(Attribute::Color)) {
+    if (attributes.has(Attribute::Color)) {
         header += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
     }
-    if (points.attributes.has(Attribute::Intensity)) {
+    if (attributes.has(Attribute::Intensity)) {
         header += "property ushort intensity\n";
     }
     header += "end_header\n";
@@ -176,17 +177,46 @@ void writeAsciiBody(AtomicFileWriter& out, const PointBatch& points, const CubeT
 
 } // namespace
 
+PlyStreamWriter::PlyStreamWriter(const std::string& path, std::uint64_t pointCount,
+                                 AttributeSet attributes, const PlyWriteOptions& options)
+    : m_out(path), m_options(options), m_attributes(attributes), m_pointCount(pointCount) {
+    m_out.write(headerText(pointCount, attributes, options));
+}
+
+void PlyStreamWriter::append(const PointBatch& points, const CubeTransform& cube) {
+    assert(points.consistent());
+    if (points.attributes != m_attributes) {
+        throw OutputError(m_out.targetPath() +
+                          ": a batch's attributes differ from those the header declares");
+    }
+    if (points.size() > m_pointCount - m_pointsWritten) {
+        throw OutputError(m_out.targetPath() + ": " +
+                          std::to_string(m_pointsWritten + points.size()) +
+                          " points appended, but the header declares " +
+                          std::to_string(m_pointCount));
+    }
+    if (m_options.encoding == PlyEncoding::Ascii) {
+        writeAsciiBody(m_out, points, cube, m_options);
+    } else {
+        writeBinaryBody(m_out, points, cube, m_options);
+    }
+    m_pointsWritten += points.size();
+}
+
+void PlyStreamWriter::finish() {
+    if (m_pointsWritten != m_pointCount) {
+        throw OutputError(m_out.targetPath() + ": only " + std::to_string(m_pointsWritten) +
+                          " points appended, but the header declares " +
+                          std::to_string(m_pointCount));
+    }
+    m_out.commit();
+}
+
 void writePly(const std::string& path, const PointBatch& points, const CubeTransform& cube,
               const PlyWriteOptions& options) {
-    assert(points.consistent());
-    AtomicFileWriter out(path);
-    out.write(headerText(points, options));
-    if (options.encoding == PlyEncoding::Ascii) {
-        writeAsciiBody(out, points, cube, options);
-    } else {
-        writeBinaryBody(out, points, cube, options);
-    }
-    out.commit();
+    PlyStreamWriter writer(path, points.size(), points.attributes, options);
+    writer.append(points, cube);
+    writer.finish();
 }
 
 glm::dvec3 plyStorageOffset(const CubeTransform& cube, const glm::dvec3& preferred) {
