@@ -51,8 +51,8 @@ struct TileGrid {
         const std::uint64_t rows = (copies + columns - 1) / columns;
         const std::uint64_t usedColumns = std::min(copies, columns);
         Bounds all = one;
-        all.extend(one.max + glm::dvec3(double(usedColumns - 1) * step.x,
-                                        double(rows - 1) * step.y, 0.0));
+        all.extend(one.max +
+                   glm::dvec3(double(usedColumns - 1) * step.x, double(rows - 1) * step.y, 0.0));
         return all;
     }
 };
@@ -71,8 +71,8 @@ AttributeSet withoutNormals(AttributeSet attributes) {
 using TileWriter = std::variant<std::unique_ptr<PlyStreamWriter>, std::unique_ptr<LasStreamWriter>>;
 
 TileWriter openWriter(const std::string& inPath, const std::string& outPath,
-                      const std::string& extension, std::uint64_t points,
-                      AttributeSet attributes, const CloudInfo& info, const Bounds& all) {
+                      const std::string& extension, std::uint64_t points, AttributeSet attributes,
+                      const CloudInfo& info, const Bounds& all) {
     const CubeTransform outCube = CubeTransform::fromBounds(all);
     if (extension == ".ply") {
         PlyWriteOptions options;
@@ -99,8 +99,8 @@ int runTile(const std::vector<std::string>& args) {
         return 0;
     }
     if (parsed.positionals.size() != 2) {
-        throw UsageError("expected IN and OUT, found " +
-                         std::to_string(parsed.positionals.size()) + " arguments");
+        throw UsageError("expected IN and OUT, found " + std::to_string(parsed.positionals.size()) +
+                         " arguments");
     }
     const std::string& inPath = parsed.positionals[0];
     const std::string& outPath = parsed.positionals[1];
@@ -136,8 +136,7 @@ int runTile(const std::vector<std::string>& args) {
     {
         auto reader = openPointCloud(inPath, openOptions);
         info = reader->info();
-        const ReadSummary summary = reader->read(
-            [](const PointBatch&) {}, readOptions);
+        const ReadSummary summary = reader->read([](const PointBatch&) {}, readOptions);
         throwIfInterrupted();
         perCopy = summary.pointsDelivered;
     }
@@ -148,8 +147,7 @@ int runTile(const std::vector<std::string>& args) {
     const std::uint64_t total = perCopy * copies;
     const TileGrid grid(copies, info.sourceBounds, gap);
     const Bounds all = grid.bounds(info.sourceBounds, copies);
-    TileWriter writer =
-        openWriter(inPath, outPath, extension, total, info.attributes, info, all);
+    TileWriter writer = openWriter(inPath, outPath, extension, total, info.attributes, info, all);
 
     // Later reads know the bounds: no pre-pass, one sequential read per copy.
     openOptions.knownBounds = info.sourceBounds;

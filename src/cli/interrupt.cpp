@@ -10,7 +10,9 @@ namespace {
 std::atomic<bool> g_interrupted{false};
 static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
 
-extern "C" void onInterrupt(int) { g_interrupted.store(true, std::memory_order_relaxed); }
+extern "C" void onInterrupt(int) {
+    g_interrupted.store(true, std::memory_order_relaxed);
+}
 
 } // namespace
 

@@ -370,5 +370,58 @@ TEST(LasWriterTest, RejectsCoordinatesOutsideInt32) {
     expectWriteFails(noOffset, cloud, "does not fit in LAS's 32-bit integer coordinates");
 }
 
+// Streamed in uneven pieces, the file is byte for byte the one writeLas makes of the whole
+// batch, header bounds included (they cover every piece).
+TEST(LasStreamWriterTest, PiecesGiveTheSameFileAsOneBatch) {
+    for (const std::uint8_t format : {std::uint8_t{3}, std::uint8_t{7}}) {
+        const SourceCloud cloud =
+            makeCloud(1000, AttributeSet(Attribute::Intensity) | Attribute::Color);
+        test::TempDir dir;
+        writeLas(dir.file("whole.las"), cloud.batch, cloud.cube, options(4, format));
+        LasStreamWriter writer(dir.file("pieces.las"), 1000, cloud.batch.attributes,
+                               options(4, format));
+        for (const auto& [first, last] : {std::pair{0, 1}, std::pair{1, 1}, std::pair{1, 1000}}) {
+            PointBatch piece;
+            piece.attributes = cloud.batch.attributes;
+            for (int i = first; i < last; ++i) {
+                piece.positions.push_back(cloud.batch.positions[i]);
+                piece.colors.push_back(cloud.batch.colors[i]);
+                piece.intensities.push_back(cloud.batch.intensities[i]);
+            }
+            writer.append(piece, cloud.cube);
+        }
+        EXPECT_EQ(writer.pointsWritten(), 1000u);
+        writer.finish();
+        EXPECT_EQ(test::readBytes(dir.file("whole.las")), test::readBytes(dir.file("pieces.las")));
+        expectSamePositions(cloud, readBack(dir.file("pieces.las")));
+    }
+}
+
+TEST(LasStreamWriterTest, AWrongCountFailsAndLeavesNoFile) {
+    const SourceCloud cloud = makeCloud(10, AttributeSet(Attribute::Intensity));
+    test::TempDir dir;
+    const std::string path = dir.file("short.las");
+    {
+        LasStreamWriter writer(path, 11, cloud.batch.attributes, options(2, 1));
+        writer.append(cloud.batch, cloud.cube);
+        try {
+            writer.finish();
+            FAIL() << "finish() accepted 10 of 11 points";
+        } catch (const OutputError& error) {
+            EXPECT_NE(std::string(error.what())
+                          .find("only 10 points appended, but the header "
+                                "declares 11"),
+                      std::string::npos)
+                << error.what();
+        }
+    }
+    {
+        LasStreamWriter writer(path, 15, cloud.batch.attributes, options(2, 1));
+        writer.append(cloud.batch, cloud.cube);
+        EXPECT_THROW(writer.append(cloud.batch, cloud.cube), OutputError); // 20 > 15
+    }
+    EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
+}
+
 } // namespace
 } // namespace omicron

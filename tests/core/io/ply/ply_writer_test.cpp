@@ -252,5 +252,60 @@ TEST(PlyWriter, MissingFolderThrowsOutputErrorAndCreatesNothing) {
     EXPECT_FALSE(std::filesystem::exists(path));
 }
 
+// Streamed in uneven pieces, the file is byte for byte the one writePly makes of the whole.
+TEST(PlyStreamWriterTest, PiecesGiveTheSameFileAsOneBatch) {
+    for (PlyEncoding encoding : {PlyEncoding::Ascii, PlyEncoding::BinaryBigEndian}) {
+        const AttributeSet attributes =
+            AttributeSet(Attribute::Normal) | Attribute::Color | Attribute::Intensity;
+        const PointBatch batch = makeBatch(attributes, 5000);
+        test::TempDir dir;
+        PlyWriteOptions options;
+        options.encoding = encoding;
+        options.offset = kOffset;
+        writePly(dir.file("whole.ply"), batch, kCube, options);
+        PlyStreamWriter writer(dir.file("pieces.ply"), batch.size(), attributes, options);
+        for (const auto& [first, last] : {std::pair{0, 1}, std::pair{1, 1}, std::pair{1, 5000}}) {
+            PointBatch piece;
+            piece.attributes = attributes;
+            for (int i = first; i < last; ++i) {
+                piece.positions.push_back(batch.positions[i]);
+                piece.normals.push_back(batch.normals[i]);
+                piece.colors.push_back(batch.colors[i]);
+                piece.intensities.push_back(batch.intensities[i]);
+            }
+            writer.append(piece, kCube);
+        }
+        writer.finish();
+        EXPECT_EQ(test::readBytes(dir.file("whole.ply")), test::readBytes(dir.file("pieces.ply")));
+    }
+}
+
+TEST(PlyStreamWriterTest, AWrongCountOrAttributeSetFailsAndLeavesNoFile) {
+    const PointBatch batch = makeBatch(AttributeSet(Attribute::Color), 10);
+    test::TempDir dir;
+    const std::string path = dir.file("out.ply");
+    {
+        PlyStreamWriter writer(path, 11, batch.attributes);
+        writer.append(batch, kCube);
+        try {
+            writer.finish();
+            FAIL() << "finish() accepted 10 of 11 points";
+        } catch (const OutputError& error) {
+            EXPECT_EQ(std::string(error.what()),
+                      path + ": only 10 points appended, but the header declares 11");
+        }
+    }
+    {
+        PlyStreamWriter writer(path, 15, batch.attributes);
+        writer.append(batch, kCube);
+        EXPECT_THROW(writer.append(batch, kCube), OutputError); // 20 > 15
+    }
+    {
+        PlyStreamWriter writer(path, 10, AttributeSet(Attribute::Intensity));
+        EXPECT_THROW(writer.append(batch, kCube), OutputError);
+    }
+    EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
+}
+
 } // namespace
 } // namespace omicron
