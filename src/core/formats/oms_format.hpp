@@ -17,6 +17,7 @@
 #pragma once
 
 #include "points/point_batch.hpp"
+#include "points/point_records.hpp"
 
 #include <array>
 #include <bit>
@@ -65,32 +66,8 @@ inline constexpr std::size_t kPointCount = 8; // u64, equal to the header's
 inline constexpr std::size_t kChecksum = 16;  // u64, XXH3-64 (seed 0) of every record byte
 } // namespace footer
 
-// Where each attribute sits inside a record; absent attributes have no bytes.
-struct RecordLayout {
-    std::size_t normalOffset = 0;
-    std::size_t colorOffset = 0;
-    std::size_t intensityOffset = 0;
-    std::size_t bytes = 0;
-
-    static constexpr RecordLayout of(AttributeSet attributes) {
-        RecordLayout layout;
-        std::size_t at = 3 * sizeof(float);
-        if (attributes.has(Attribute::Normal)) {
-            layout.normalOffset = at;
-            at += 3 * sizeof(float);
-        }
-        if (attributes.has(Attribute::Color)) {
-            layout.colorOffset = at;
-            at += 3;
-        }
-        if (attributes.has(Attribute::Intensity)) {
-            layout.intensityOffset = at;
-            at += sizeof(std::uint16_t);
-        }
-        layout.bytes = at;
-        return layout;
-    }
-};
+// The record layout (points/point_records.hpp), shared with the sorter's scratch runs.
+using RecordLayout = PointRecordLayout;
 
 // XXH64 (seed 0) of a header's first header::kChecksum bytes.
 std::uint64_t headerChecksum(const std::uint8_t* headerBytes);

@@ -1,6 +1,8 @@
 #include "sort/morton_sorter.hpp"
 
+#include "memory_budget.hpp"
 #include "sort/radix_sort.hpp"
+#include "sort/run_merger.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -19,29 +21,52 @@ double secondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// splitmix64: a fixed, portable hash, so the preview is the same on every machine.
-std::uint64_t mix(std::uint64_t x) {
-    x += 0x9e3779b97f4a7c15ull;
-    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-    return x ^ (x >> 31);
+// Bytes of one point in a PointBatch with these attributes.
+std::uint64_t batchBytesPerPoint(AttributeSet attributes) {
+    return sizeof(glm::vec3) + (attributes.has(Attribute::Normal) ? sizeof(glm::vec3) : 0) +
+           (attributes.has(Attribute::Color) ? sizeof(glm::u8vec3) : 0) +
+           (attributes.has(Attribute::Intensity) ? sizeof(std::uint16_t) : 0);
 }
+
+// Runs are sized from half the budget; the rest covers the merge's read buffers, the write
+// block and what the stages after the sort keep.
+constexpr std::uint64_t kMinRunPoints = 4096;
 
 } // namespace
 
+std::uint64_t IncrementalMortonSorter::inMemoryBytes(const CloudInfo& info) {
+    // Input in arrival order + bin code and index + the sorted cloud's copy + chunk scratch.
+    const std::uint64_t perPoint = 2 * batchBytesPerPoint(info.attributes) +
+                                   sizeof(morton::Code) + sizeof(std::uint32_t) + 1;
+    return info.pointCount * perPoint;
+}
+
 IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const SortOptions& options)
-    : m_info(info), m_options(options), m_bins(kBins) {
+    : m_info(info), m_options(options), m_preview(options.previewPoints, options.previewSeed) {
     if (info.pointCount > UINT32_MAX) {
         throw std::length_error(info.path + ": " + std::to_string(info.pointCount) +
-                                " points exceed the in-memory sorter's limit of 2^32-1");
+                                " points exceed the sorter's limit of 2^32-1");
     }
     m_options.chunks = std::clamp(m_options.chunks, 1, kMaxSortChunks);
     m_options.batchPoints = std::max<std::size_t>(m_options.batchPoints, 1);
+    const std::uint64_t budget =
+        m_options.memoryBudgetBytes != 0 ? m_options.memoryBudgetBytes : defaultMemoryBudget();
+    m_options.memoryBudgetBytes = budget;
     const auto capacity = static_cast<std::size_t>(info.pointCount);
     m_cloud =
         std::make_shared<SortedCloud>(info.cube, info.sourceOffset, info.attributes, capacity,
                                       CloudOrder::Morton, m_options.storage);
     m_input.attributes = info.attributes;
+    if (inMemoryBytes(info) > budget) {
+        const std::uint64_t runPoints =
+            std::max(kMinRunPoints, budget / 2 / RunSpiller::bytesPerBufferedPoint(info.attributes));
+        m_spiller = std::make_unique<RunSpiller>(
+            m_options.tempDir, info.attributes,
+            static_cast<std::size_t>(std::min<std::uint64_t>(runPoints, capacity)),
+            info.pointCount);
+        return;
+    }
+    m_bins.resize(kBins);
     m_input.reserve(capacity);
     const std::size_t perBin = capacity / kBins + 16;
     for (Bin& bin : m_bins) {
@@ -51,7 +76,7 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
 }
 
 void IncrementalMortonSorter::add(const PointBatch& batch) {
-    const std::size_t firstIndex = m_input.size();
+    const std::size_t firstIndex = m_pointsAdded;
     if (firstIndex + batch.size() > m_cloud->capacity()) {
         throw std::length_error(m_info.path + ": the reader delivered more points than the " +
                                 std::to_string(m_cloud->capacity()) + " its header declared");
@@ -65,6 +90,12 @@ void IncrementalMortonSorter::add(const PointBatch& batch) {
                               m_batchCodes[i] = morton::encodeUnit(p.x, p.y, p.z);
                           }
                       });
+    m_pointsAdded += count;
+    m_preview.add(batch, firstIndex);
+    if (m_spiller) {
+        m_spiller->add(batch, m_batchCodes);
+        return;
+    }
     // The counting pass and first distribution, done while the data arrives.
     constexpr int binShift = 3 * morton::kMaxLevel - kBinBits;
     for (std::size_t i = 0; i < count; ++i) {
@@ -74,41 +105,12 @@ void IncrementalMortonSorter::add(const PointBatch& batch) {
         bin.indices.push_back(static_cast<std::uint32_t>(firstIndex + i));
     }
     m_input.append(batch);
-    samplePreview(batch, firstIndex);
 }
 
-void IncrementalMortonSorter::samplePreview(const PointBatch& batch, std::uint64_t firstIndex) {
-    const std::size_t capacity = m_options.previewPoints;
-    if (capacity == 0) {
-        return;
-    }
-    const bool hasColor = !batch.colors.empty();
-    std::lock_guard lock(m_previewMutex);
-    // Reservoir sampling: point i replaces a random slot with probability capacity / (i + 1).
-    for (std::size_t i = 0; i < batch.size(); ++i) {
-        const std::uint64_t index = firstIndex + i;
-        if (index < capacity) {
-            m_preview.positions.push_back(batch.positions[i]);
-            if (hasColor) {
-                m_preview.colors.push_back(batch.colors[i]);
-            }
-            continue;
-        }
-        const auto slot =
-            static_cast<std::size_t>(mix(m_options.previewSeed ^ index) % (index + 1));
-        if (slot < capacity) {
-            m_preview.positions[slot] = batch.positions[i];
-            if (hasColor) {
-                m_preview.colors[slot] = batch.colors[i];
-            }
-        }
-    }
-    m_preview.pointsSeen = firstIndex + batch.size();
-}
+PreviewSample IncrementalMortonSorter::preview() const { return m_preview.sample(); }
 
-PreviewSample IncrementalMortonSorter::preview() const {
-    std::lock_guard lock(m_previewMutex);
-    return m_preview;
+bool IncrementalMortonSorter::cancelled() const {
+    return m_options.cancel != nullptr && m_options.cancel->load(std::memory_order_relaxed);
 }
 
 // Bin index where each chunk starts, plus kBins at the end: contiguous bin ranges of about
@@ -136,6 +138,9 @@ std::vector<std::size_t> IncrementalMortonSorter::chunkBinBoundaries() const {
 }
 
 int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
+    if (m_spiller) {
+        return mergeAndEmit(consumer);
+    }
     const auto start = Clock::now();
     const std::vector<std::size_t> boundaries = chunkBinBoundaries();
     const std::size_t chunks = boundaries.size() - 1;
@@ -155,9 +160,6 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
     std::vector<std::uint64_t> keys(largestChunk), keyScratch(largestChunk);
     std::vector<std::uint32_t> indices(largestChunk), indexScratch(largestChunk);
     SortedCloud& cloud = *m_cloud;
-    const auto cancelled = [&] {
-        return m_options.cancel != nullptr && m_options.cancel->load(std::memory_order_relaxed);
-    };
 
     std::size_t nextChunk = 0;
     int chunksDone = 0;
@@ -233,6 +235,53 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
         cloud.markComplete();
     }
     return chunksDone;
+}
+
+// The merge feeds the sorted cloud batch by batch: staged, published, handed out.
+int IncrementalMortonSorter::mergeAndEmit(const SortedRangeConsumer& consumer) {
+    const auto start = Clock::now();
+    SortedCloud& cloud = *m_cloud;
+    std::size_t end = 0;
+    emitSortedBatches([&](const PointBatch& sorted) {
+        const std::size_t n = sorted.size();
+        const SortedCloud::StagedRange out = cloud.stage(end + n);
+        std::copy(sorted.positions.begin(), sorted.positions.end(), out.positions.begin());
+        std::copy(sorted.normals.begin(), sorted.normals.end(), out.normals.begin());
+        std::copy(sorted.colors.begin(), sorted.colors.end(), out.colors.begin());
+        std::copy(sorted.intensities.begin(), sorted.intensities.end(), out.intensities.begin());
+        cloud.publish(end + n);
+        if (m_firstRangeSeconds < 0.0) {
+            m_firstRangeSeconds = secondsSince(start);
+        }
+        consumer(cloud, end, end + n);
+        end += n;
+    });
+    if (!cancelled() && end == m_pointsAdded) {
+        cloud.markComplete();
+    }
+    return static_cast<int>(m_spiller->runs().size());
+}
+
+void IncrementalMortonSorter::emitSortedBatches(const SortedBatchConsumer& consumer) {
+    if (!m_spiller) {
+        throw std::logic_error("emitSortedBatches() needs a spilling sort");
+    }
+    m_spiller->finish();
+    // A quarter of the budget for the runs' read buffers, at least 64 KiB a run.
+    const std::size_t runs = m_spiller->runs().size();
+    const std::size_t bufferBytes = static_cast<std::size_t>(std::max<std::uint64_t>(
+        m_options.memoryBudgetBytes / 4, std::uint64_t{runs} * (std::uint64_t{1} << 16)));
+    RunMerger merger(m_spiller->runs(), m_info.attributes, bufferBytes);
+    PointBatch sorted;
+    sorted.attributes = m_info.attributes;
+    sorted.reserve(m_options.batchPoints);
+    while (!cancelled()) {
+        sorted.clear();
+        if (merger.next(sorted, m_options.batchPoints) == 0) {
+            break;
+        }
+        consumer(sorted);
+    }
 }
 
 SortSummary sortPointCloud(PointReader& reader, const SortOptions& options,

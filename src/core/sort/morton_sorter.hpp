@@ -8,10 +8,17 @@
 // radix sorted (all cores) and copied into the SortedCloud, whose prefix is then published and
 // handed to the consumer in batches — while the next chunk is already being sorted. The
 // output is the stable Morton order of the input: identical for any K and thread count.
+//
+// A cloud whose in-memory sort would not fit the memory budget is sorted externally instead:
+// add() buffers a run's worth of points and spills it sorted to the scratch folder
+// (RunSpiller), and sortAndEmit() merges the runs (RunMerger) into the same stable order, so
+// the output is point for point the same. The preview is taken while reading in both modes.
 #pragma once
 
 #include "io/point_reader.hpp"
 #include "points/sorted_cloud.hpp"
+#include "sort/preview_sampler.hpp"
+#include "sort/run_spiller.hpp"
 
 #include <array>
 #include <atomic>
@@ -36,13 +43,10 @@ struct SortOptions {
     std::uint64_t previewSeed = 0x9e3779b97f4a7c15ull;
     const std::atomic<bool>* cancel = nullptr;        // checked between chunks and batches
     PointStorage storage = PointStorage::Exact;       // how the sorted cloud keeps its points
-};
-
-// A uniform random subsample of the points added so far (positions in the unit cube).
-struct PreviewSample {
-    std::vector<glm::vec3> positions;
-    std::vector<glm::u8vec3> colors; // empty when the cloud has no colour
-    std::uint64_t pointsSeen = 0;
+    // What the sort may keep resident (0: defaultMemoryBudget()); a cloud whose in-memory sort
+    // needs more is sorted in runs on disk, under `tempDir` (empty: $TMPDIR or /tmp).
+    std::uint64_t memoryBudgetBytes = 0;
+    std::string tempDir;
 };
 
 // Receives [begin, end) of `cloud`, already published: every code in it is >= every code of
@@ -50,10 +54,25 @@ struct PreviewSample {
 using SortedRangeConsumer =
     std::function<void(const SortedCloud& cloud, std::size_t begin, std::size_t end)>;
 
+// Receives the next points of the sorted stream (unit cube, the cloud's attributes); the
+// batch is reused after the call.
+using SortedBatchConsumer = std::function<void(const PointBatch& sorted)>;
+
 class IncrementalMortonSorter {
 public:
-    // `info` of the reader that will feed add(); throws std::length_error beyond 2^32-1 points.
+    // `info` of the reader that will feed add(); throws std::length_error beyond 2^32-1 points,
+    // OutputError when a spilling sort cannot make its scratch folder or the file system there
+    // lacks the space its runs need.
     IncrementalMortonSorter(const CloudInfo& info, const SortOptions& options);
+
+    // Bytes the in-memory sort of `info`'s points keeps resident at its peak: the input in
+    // arrival order, codes and indices in their bins, the sorted cloud, chunk scratch.
+    static std::uint64_t inMemoryBytes(const CloudInfo& info);
+
+    // True when this sort spills runs to disk (its in-memory sort exceeds the budget).
+    bool spills() const { return m_spiller != nullptr; }
+    // Runs written so far (0 for an in-memory sort).
+    std::size_t runCount() const { return m_spiller ? m_spiller->runs().size() : 0; }
 
     // Reading phase (one thread): appends a batch in the unit cube of info.cube.
     void add(const PointBatch& batch);
@@ -61,13 +80,19 @@ public:
     // Any thread, any time: a copy of the current preview sample (bounded size).
     PreviewSample preview() const;
 
-    std::uint64_t pointCount() const { return m_input.size(); }
+    std::uint64_t pointCount() const { return m_pointsAdded; }
     std::shared_ptr<const SortedCloud> cloud() const { return m_cloud; }
 
     // Sorting phase: sorts chunk after chunk and calls `consumer` for every sorted range, in
     // Morton order. Returns the number of chunks used (<= options.chunks; 0 if cancelled
-    // before the first). Call once, after the last add().
+    // before the first; for a spilling sort, the number of runs merged). Call once, after the
+    // last add().
     int sortAndEmit(const SortedRangeConsumer& consumer);
+
+    // A spilling sort only, instead of sortAndEmit(): the merged stream in batches of at most
+    // options.batchPoints, without filling the sorted cloud, so memory stays within the budget
+    // whatever the cloud's size (how `omicron-cli sort` writes a .oms). Call once.
+    void emitSortedBatches(const SortedBatchConsumer& consumer);
 
     // Seconds from the start of sortAndEmit() to the first consumer call (-1 before it).
     double firstRangeSeconds() const { return m_firstRangeSeconds; }
@@ -81,8 +106,9 @@ private:
         std::vector<std::uint32_t> indices;
     };
 
-    void samplePreview(const PointBatch& batch, std::uint64_t firstIndex);
     std::vector<std::size_t> chunkBinBoundaries() const;
+    int mergeAndEmit(const SortedRangeConsumer& consumer);
+    bool cancelled() const;
 
     CloudInfo m_info;
     SortOptions m_options;
@@ -92,9 +118,10 @@ private:
     PointBatch m_input;
     std::vector<Bin> m_bins;
     std::vector<morton::Code> m_batchCodes; // scratch for add()
+    std::uint64_t m_pointsAdded = 0;
+    std::unique_ptr<RunSpiller> m_spiller; // a spilling sort's runs, else null
 
-    mutable std::mutex m_previewMutex;
-    PreviewSample m_preview;
+    PreviewSampler m_preview;
 
     double m_firstRangeSeconds = -1.0;
 };

@@ -1,0 +1,92 @@
+#include "sort/run_merger.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+namespace omicron {
+
+RunMerger::RunMerger(const std::vector<SortedRun>& runs, AttributeSet attributes,
+                     std::size_t bufferBytes)
+    : m_layout(PointRecordLayout::of(attributes)) {
+    const std::size_t perRun = bufferBytes / std::max<std::size_t>(runs.size(), 1);
+    m_recordsPerBuffer = std::max<std::size_t>(1, perRun / m_layout.bytes);
+    m_cursors.resize(runs.size());
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+        m_cursors[r].file = runs[r].file.get();
+        m_cursors[r].points = runs[r].points;
+        m_pointsLeft += runs[r].points;
+        if (refill(m_cursors[r])) {
+            m_heap.push_back(static_cast<std::uint32_t>(r));
+        }
+    }
+    for (std::size_t slot = m_heap.size() / 2; slot-- > 0;) {
+        siftDown(slot);
+    }
+}
+
+bool RunMerger::refill(Cursor& cursor) {
+    if (cursor.nextToLoad == cursor.points) {
+        return false;
+    }
+    const std::size_t count = static_cast<std::size_t>(
+        std::min<std::uint64_t>(m_recordsPerBuffer, cursor.points - cursor.nextToLoad));
+    cursor.records.resize(count * m_layout.bytes);
+    cursor.file->read(cursor.nextToLoad * m_layout.bytes, cursor.records.data(),
+                      cursor.records.size());
+    // The code of a stored float position is bit for bit the one the run was sorted by.
+    cursor.codes.resize(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        float xyz[3];
+        std::memcpy(xyz, cursor.records.data() + i * m_layout.bytes, sizeof xyz);
+        cursor.codes[i] = morton::encodeUnit(xyz[0], xyz[1], xyz[2]);
+    }
+    cursor.nextToLoad += count;
+    cursor.at = 0;
+    cursor.buffered = count;
+    return true;
+}
+
+bool RunMerger::lessThan(std::uint32_t a, std::uint32_t b) const {
+    const morton::Code codeA = m_cursors[a].codes[m_cursors[a].at];
+    const morton::Code codeB = m_cursors[b].codes[m_cursors[b].at];
+    return codeA < codeB || (codeA == codeB && a < b);
+}
+
+void RunMerger::siftDown(std::size_t slot) {
+    const std::size_t size = m_heap.size();
+    for (;;) {
+        const std::size_t left = 2 * slot + 1;
+        if (left >= size) {
+            return;
+        }
+        std::size_t smallest = left;
+        if (left + 1 < size && lessThan(m_heap[left + 1], m_heap[left])) {
+            smallest = left + 1;
+        }
+        if (!lessThan(m_heap[smallest], m_heap[slot])) {
+            return;
+        }
+        std::swap(m_heap[smallest], m_heap[slot]);
+        slot = smallest;
+    }
+}
+
+std::size_t RunMerger::next(PointBatch& out, std::size_t maxPoints) {
+    std::size_t emitted = 0;
+    while (emitted < maxPoints && !m_heap.empty()) {
+        Cursor& top = m_cursors[m_heap.front()];
+        decodePointRecord(m_layout, top.records.data() + top.at * m_layout.bytes, out);
+        ++emitted;
+        if (++top.at == top.buffered && !refill(top)) {
+            m_heap.front() = m_heap.back();
+            m_heap.pop_back();
+        }
+        if (!m_heap.empty()) {
+            siftDown(0);
+        }
+    }
+    m_pointsLeft -= emitted;
+    return emitted;
+}
+
+} // namespace omicron

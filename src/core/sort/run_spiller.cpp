@@ -1,0 +1,131 @@
+#include "sort/run_spiller.hpp"
+
+#include "io/atomic_file_writer.hpp"
+#include "memory_budget.hpp"
+#include "sort/radix_sort.hpp"
+
+#include <algorithm>
+#include <numeric>
+#include <tbb/parallel_for.h>
+
+namespace omicron {
+
+namespace {
+
+// Records are encoded into blocks of this size before each write.
+constexpr std::size_t kWriteBlockBytes = std::size_t{4} << 20;
+
+std::size_t batchBytesPerPoint(AttributeSet attributes) {
+    std::size_t bytes = sizeof(glm::vec3);
+    if (attributes.has(Attribute::Normal)) {
+        bytes += sizeof(glm::vec3);
+    }
+    if (attributes.has(Attribute::Color)) {
+        bytes += sizeof(glm::u8vec3);
+    }
+    if (attributes.has(Attribute::Intensity)) {
+        bytes += sizeof(std::uint16_t);
+    }
+    return bytes;
+}
+
+} // namespace
+
+std::size_t RunSpiller::bytesPerBufferedPoint(AttributeSet attributes) {
+    // code, then the sort's key + index and their scratch copies.
+    return batchBytesPerPoint(attributes) + sizeof(morton::Code) +
+           2 * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
+}
+
+RunSpiller::RunSpiller(const std::string& tempParent, AttributeSet attributes,
+                       std::size_t runPoints, std::uint64_t totalPoints)
+    : m_folder(tempParent), m_layout(PointRecordLayout::of(attributes)),
+      m_runPoints(std::max<std::size_t>(runPoints, 1)) {
+    const std::uint64_t needed = totalPoints * m_layout.bytes;
+    m_folder.setBytesNeeded(needed);
+    const std::uint64_t free = m_folder.freeBytes();
+    if (free < needed) {
+        throw OutputError(m_folder.parent() + ": the sorted runs of this cloud need " +
+                          formatByteSize(needed) + " (" + std::to_string(needed) +
+                          " bytes) of scratch space, but only " + formatByteSize(free) +
+                          " are free there; free space or choose another folder with "
+                          "--temp-dir");
+    }
+    m_buffer.attributes = attributes;
+    // Reserved, not touched: pages become resident as the run fills, and never move.
+    m_buffer.reserve(m_runPoints);
+    m_codes.reserve(m_runPoints);
+}
+
+void RunSpiller::add(const PointBatch& batch, std::span<const morton::Code> codes) {
+    for (std::size_t first = 0; first < batch.size();) {
+        const std::size_t room = m_runPoints - m_buffer.size();
+        const std::size_t take = std::min(room, batch.size() - first);
+        if (first == 0 && take == batch.size()) {
+            m_buffer.append(batch);
+        } else {
+            PointBatch part;
+            part.attributes = batch.attributes;
+            const auto slice = [&](const auto& from, auto& to) {
+                if (!from.empty()) {
+                    to.assign(from.begin() + first, from.begin() + first + take);
+                }
+            };
+            slice(batch.positions, part.positions);
+            slice(batch.normals, part.normals);
+            slice(batch.colors, part.colors);
+            slice(batch.intensities, part.intensities);
+            m_buffer.append(part);
+        }
+        m_codes.insert(m_codes.end(), codes.begin() + first, codes.begin() + first + take);
+        first += take;
+        if (m_buffer.size() == m_runPoints) {
+            spill();
+        }
+    }
+}
+
+void RunSpiller::finish() {
+    if (!m_buffer.empty()) {
+        spill();
+    }
+    PointBatch released; // the buffers' memory goes back before the merge needs its own
+    released.attributes = m_buffer.attributes;
+    m_buffer = std::move(released);
+    m_codes = {};
+}
+
+void RunSpiller::spill() {
+    const std::size_t n = m_buffer.size();
+    // Stable: equal codes keep their input order, which the merge then keeps across runs.
+    std::vector<std::uint32_t> order(n), orderScratch(n);
+    std::iota(order.begin(), order.end(), 0u);
+    std::vector<std::uint64_t> keyScratch(n);
+    radixSortByKey(std::span(m_codes.data(), n), std::span(order.data(), n),
+                   std::span(keyScratch.data(), n), std::span(orderScratch.data(), n));
+    keyScratch = {};
+    orderScratch = {};
+
+    SortedRun run;
+    run.file = std::make_unique<ScratchFile>(m_folder, "run-" + std::to_string(m_runs.size()));
+    run.points = n;
+    const std::size_t recordsPerBlock = std::max<std::size_t>(1, kWriteBlockBytes / m_layout.bytes);
+    std::vector<std::uint8_t> block;
+    for (std::size_t first = 0; first < n; first += recordsPerBlock) {
+        const std::size_t count = std::min(recordsPerBlock, n - first);
+        block.resize(count * m_layout.bytes);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 16384),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                              for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                                  encodePointRecord(m_layout, m_buffer, order[first + i],
+                                                    block.data() + i * m_layout.bytes);
+                              }
+                          });
+        run.file->write(block.data(), block.size());
+    }
+    m_runs.push_back(std::move(run));
+    m_buffer.clear();
+    m_codes.clear();
+}
+
+} // namespace omicron

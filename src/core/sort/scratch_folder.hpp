@@ -1,0 +1,68 @@
+// Scratch space for clouds larger than memory: a private folder for the sorter's runs, made
+// (mkdtemp) under the folder the user chose (--temp-dir, the app's setting, else $TMPDIR or
+// /tmp) and removed with everything in it when destroyed: after success, an error, a cancel or
+// Ctrl+C (the CLI turns the signal into an exception), so no run outlives its pipeline.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace omicron {
+
+class ScratchFolder {
+public:
+    // Throws OutputError naming `parent` when the folder cannot be made there.
+    explicit ScratchFolder(const std::string& parent);
+    ~ScratchFolder();
+    ScratchFolder(const ScratchFolder&) = delete;
+    ScratchFolder& operator=(const ScratchFolder&) = delete;
+
+    const std::string& path() const { return m_path; }
+    const std::string& parent() const { return m_parent; }
+
+    // Bytes its file system has free for us (statvfs), UINT64_MAX when it cannot tell.
+    std::uint64_t freeBytes() const;
+
+    // What the runs of this cloud need in all, for the message of a failed write.
+    void setBytesNeeded(std::uint64_t bytes) { m_bytesNeeded = bytes; }
+    std::uint64_t bytesNeeded() const { return m_bytesNeeded; }
+    std::uint64_t bytesWritten() const { return m_bytesWritten; }
+
+    // Where scratch goes when the user chose nothing: $TMPDIR, else /tmp.
+    static std::string defaultParent();
+
+private:
+    friend class ScratchFile;
+    // A write failed (full disk, quota, I/O error): an OutputError naming the folder the user
+    // chose, the bytes needed and written, and what to do.
+    [[noreturn]] void failWrite(const std::string& file, int error) const;
+
+    std::string m_parent;
+    std::string m_path;
+    std::uint64_t m_bytesNeeded = 0;
+    std::uint64_t m_bytesWritten = 0;
+};
+
+// One file in a ScratchFolder, written front to back, then read by offset from any thread.
+class ScratchFile {
+public:
+    ScratchFile(ScratchFolder& folder, const std::string& name); // throws OutputError
+    ~ScratchFile();
+    ScratchFile(const ScratchFile&) = delete;
+    ScratchFile& operator=(const ScratchFile&) = delete;
+
+    void write(const void* data, std::size_t count); // appends; throws OutputError
+    // Reads exactly `count` bytes at `offset`; throws std::runtime_error naming the file.
+    void read(std::uint64_t offset, void* data, std::size_t count) const;
+    std::uint64_t size() const { return m_size; }
+    const std::string& path() const { return m_path; }
+
+private:
+    ScratchFolder& m_folder;
+    std::string m_path;
+    int m_fd = -1;
+    std::uint64_t m_size = 0;
+};
+
+} // namespace omicron
