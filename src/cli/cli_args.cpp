@@ -1,9 +1,12 @@
 #include "cli_args.hpp"
 
+#include "memory_budget.hpp"
 #include "sort/morton_sorter.hpp"
+#include "sort/scratch_folder.hpp"
 
 #include <algorithm>
 #include <charconv>
+#include <filesystem>
 #include <tbb/info.h>
 
 namespace omicron::cli {
@@ -97,6 +100,43 @@ int sortChunksOption(const ParsedArgs& parsed) {
     const auto text = parsed.value("chunks");
     return text ? static_cast<int>(parseInteger(*text, "chunks", 1, kMaxSortChunks))
                 : kDefaultSortChunks;
+}
+
+MemoryOptions memoryOptions(const ParsedArgs& parsed, const std::string& outputPath) {
+    MemoryOptions memory;
+    if (const auto text = parsed.value("memory-budget")) {
+        const std::optional<std::uint64_t> bytes = parseByteSize(*text);
+        if (!bytes) {
+            throw UsageError("bad size for --memory-budget: '" + *text +
+                             "' (expected e.g. 512M, 4G or a number of bytes)");
+        }
+        if (*bytes < kMinMemoryBudget) {
+            throw UsageError("--memory-budget " + *text + " is below the minimum of " +
+                             formatByteSize(kMinMemoryBudget));
+        }
+        memory.budgetBytes = *bytes;
+    }
+    if (const auto folder = parsed.value("temp-dir")) {
+        std::error_code error;
+        if (!std::filesystem::is_directory(*folder, error)) {
+            throw UsageError("--temp-dir '" + *folder + "' is not an existing folder");
+        }
+        memory.tempDir = *folder;
+    } else if (!outputPath.empty()) {
+        // Beside the output: the disk meant for big files, rather than a /tmp that may be
+        // small or in memory.
+        const std::filesystem::path parent = std::filesystem::path(outputPath).parent_path();
+        memory.tempDir = parent.empty() ? "." : parent.string();
+    } else {
+        memory.tempDir = ScratchFolder::defaultParent();
+    }
+    return memory;
+}
+
+std::vector<OptionSpec> withOptions(std::vector<OptionSpec> specs,
+                                    const std::vector<OptionSpec>& more) {
+    specs.insert(specs.end(), more.begin(), more.end());
+    return specs;
 }
 
 } // namespace omicron::cli

@@ -50,4 +50,20 @@ int threadsOption(const ParsedArgs& parsed);
 // --chunks K: sort chunks, 1..kMaxSortChunks, kDefaultSortChunks when absent.
 int sortChunksOption(const ParsedArgs& parsed);
 
+// --memory-budget SIZE and --temp-dir DIR, for every command that sorts a cloud.
+inline const std::vector<OptionSpec> kMemoryOptionSpecs{{"memory-budget", true},
+                                                        {"temp-dir", true}};
+struct MemoryOptions {
+    std::uint64_t budgetBytes = 0; // 0: the default (half of physical memory)
+    std::string tempDir;           // where sorted runs go; never empty
+};
+// The budget ("512M", "4G"; at least kMinMemoryBudget) and the scratch parent: --temp-dir
+// (an existing folder), else the folder of `outputPath` when there is one, else $TMPDIR or
+// /tmp. Throws UsageError naming the option.
+MemoryOptions memoryOptions(const ParsedArgs& parsed, const std::string& outputPath);
+
+// `specs` followed by `more`.
+std::vector<OptionSpec> withOptions(std::vector<OptionSpec> specs,
+                                    const std::vector<OptionSpec>& more);
+
 } // namespace omicron::cli

@@ -3,6 +3,7 @@
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "formats/omh_writer.hpp"
+#include "interrupt.hpp"
 #include "json_writer.hpp"
 #include "levels_json.hpp"
 #include "pipeline/build_pipeline.hpp"
@@ -11,8 +12,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <thread>
 #include <tbb/global_control.h>
+#include <thread>
 
 namespace omicron::cli {
 
@@ -83,6 +84,7 @@ void printJson(const PipelineResult& run, const BuildOptions& options, const Sav
     json.key("creation_s").value(s.creationSeconds);
     json.key("read_s").value(run.readSeconds);
     json.key("sort_s").value(run.sortSeconds);
+    json.key("sort_runs").value(static_cast<std::uint64_t>(run.sortRuns));
     json.key("bytes_resident").value(static_cast<std::uint64_t>(s.bytesResident()));
     json.key("point_storage").value(toString(s.pointStorage));
     json.key("cloud_bytes").value(static_cast<std::uint64_t>(s.cloudBytes));
@@ -122,6 +124,10 @@ void printText(const PipelineResult& run, const BuildOptions& options, const Sav
     }
     std::printf("time:        read %.3f s, sort %.3f s, hierarchy complete %.3f s after start\n",
                 run.readSeconds, run.sortSeconds, s.creationSeconds);
+    if (run.sortRuns > 0) {
+        std::printf("sort:        beyond the memory budget: %zu sorted runs on disk, merged\n",
+                    run.sortRuns);
+    }
     std::printf("memory:      %.1f MiB resident (%.1f bytes per input point), %s point store\n",
                 s.bytesResident() / 1048576.0,
                 s.inputPoints ? double(s.bytesResident()) / double(s.inputPoints) : 0.0,
@@ -133,15 +139,16 @@ void printText(const PipelineResult& run, const BuildOptions& options, const Sav
 }
 
 int runBuild(const std::vector<std::string>& args) {
-    const ParsedArgs parsed = parseArgs(args, {{"depth", true},
-                                               {"ratio", true},
-                                               {"worklist", true},
-                                               {"collapse", true},
-                                               {"threads", true},
-                                               {"chunks", true},
-                                               {"store", true},
-                                               {"json", false},
-                                               {"save", true}});
+    const ParsedArgs parsed = parseArgs(args, withOptions({{"depth", true},
+                                                           {"ratio", true},
+                                                           {"worklist", true},
+                                                           {"collapse", true},
+                                                           {"threads", true},
+                                                           {"chunks", true},
+                                                           {"store", true},
+                                                           {"json", false},
+                                                           {"save", true}},
+                                                          kMemoryOptionSpecs));
     if (parsed.help) {
         printCommandHelp(buildCommand());
         return 0;
@@ -175,8 +182,10 @@ int runBuild(const std::vector<std::string>& args) {
     }
 
     const std::string& path = parsed.positionals[0];
+    const MemoryOptions memory = memoryOptions(parsed, parsed.value("save").value_or(""));
     BuildPipeline pipeline;
-    const PipelineResult run = pipeline.run(path, {options, chunks, storage});
+    const PipelineResult run = runInterruptibly(
+        pipeline, path, {options, chunks, storage, memory.budgetBytes, memory.tempDir});
     SavedFile saved;
     if (const auto savePath = parsed.value("save")) { // the finished hierarchy, pipeline 3's input
         writeOmh(*savePath, *pipeline.hierarchy(), omhBuildInfo(options, run.stats), saveOptions());
@@ -197,7 +206,7 @@ const Command& buildCommand() {
         "build", "build the OMiCroN hierarchy of a cloud and print its statistics",
         "build IN [--depth 7] [--ratio 0.2] [--worklist N] [--collapse off|lossless|paper]\n"
         "                   [--threads T] [--chunks K] [--store exact|packed] [--save OUT.omh]\n"
-        "                   [--json]",
+        "                   [--memory-budget SIZE] [--temp-dir DIR] [--json]",
         "Builds the octree bottom-up with oblique hierarchy cuts while the input streams in:\n"
         "an unsorted cloud (PLY, LAS, XYZ) goes through the incremental Morton sorter first\n"
         "(pipeline 1), a sorted stream (.oms) feeds the builder directly (pipeline 2).\n"
@@ -217,13 +226,20 @@ const Command& buildCommand() {
         "  --save OUT.omh     save the finished hierarchy as a .omh file (written to a\n"
         "                     temporary file and renamed: an interrupted save leaves OUT as\n"
         "                     it was); 'info OUT.omh' prints the same per-level counts\n"
+        "  --memory-budget SIZE\n"
+        "                     what the sort may keep resident, e.g. 512M or 4G (default: half\n"
+        "                     of physical memory); a bigger sort runs on disk and its runs are\n"
+        "                     merged into the cloud, which stays resident for the builder\n"
+        "  --temp-dir DIR     where sorted runs go (default: OUT.omh's folder with --save,\n"
+        "                     else $TMPDIR or /tmp); removed on success, error and Ctrl+C\n"
         "  --json             one JSON object: points_in, levels [{level, nodes, leaves,\n"
-        "                     points}], creation_s, read_s, sort_s, bytes_resident\n"
+        "                     points}], creation_s, read_s, sort_s, sort_runs (0: sorted\n"
+        "                     in memory), bytes_resident\n"
         "                     (cloud_bytes + hierarchy_bytes), point_storage,\n"
         "                     milestones_s (time at 10 %, 20 %, ... of the points inserted),\n"
         "                     saved and saved_bytes with --save\n"
         "\n"
-        "Exit status: 0 ok, 1 input or output error, 2 usage error.\n",
+        "Exit status: 0 ok, 1 input or output error, 2 usage error, 130 interrupted.\n",
         runBuild};
     return command;
 }

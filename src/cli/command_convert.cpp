@@ -3,12 +3,11 @@
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "formats/oms_reader.hpp"
-#include "formats/oms_writer.hpp"
 #include "io/las/las_writer.hpp"
 #include "io/ply/ply_writer.hpp"
 #include "io/point_reader.hpp"
 #include "io/xyz/xyz_writer.hpp"
-#include "sort/morton_sorter.hpp"
+#include "sort_to_oms.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -61,29 +60,15 @@ LasWriteOptions lasOptions(const WholeCloud& whole) {
     return options;
 }
 
-void writeSorted(const std::string& inPath, const std::string& outPath) {
-    auto reader = openPointCloud(inPath);
-    OmsWriter writer;
-    sortPointCloud(*reader, SortOptions{},
-                   [&](const SortedCloud& cloud, std::size_t begin, std::size_t end) {
-                       if (begin == 0) {
-                           writer.open(outPath, cloud.cube(), cloud.sourceOffset(),
-                                       cloud.attributes(), cloud.capacity());
-                       }
-                       writer.append(cloud, begin, end);
-                   });
-    writer.finish();
-}
-
 int runConvert(const std::vector<std::string>& args) {
-    const ParsedArgs parsed = parseArgs(args, {});
+    const ParsedArgs parsed = parseArgs(args, kMemoryOptionSpecs);
     if (parsed.help) {
         printCommandHelp(convertCommand());
         return 0;
     }
     if (parsed.positionals.size() != 2) {
-        throw UsageError("expected IN and OUT, found " +
-                         std::to_string(parsed.positionals.size()) + " arguments");
+        throw UsageError("expected IN and OUT, found " + std::to_string(parsed.positionals.size()) +
+                         " arguments");
     }
     const std::string& inPath = parsed.positionals[0];
     const std::string& outPath = parsed.positionals[1];
@@ -92,14 +77,16 @@ int runConvert(const std::vector<std::string>& args) {
         if (isOmsFile(inPath)) {
             throw UsageError("IN is already a .oms sorted stream");
         }
-        writeSorted(inPath, outPath);
+        const MemoryOptions memory = memoryOptions(parsed, outPath);
+        SortOptions options;
+        options.memoryBudgetBytes = memory.budgetBytes;
+        options.tempDir = memory.tempDir;
+        sortToOms(inPath, outPath, options);
         std::printf("converted %s to the sorted stream %s\n", inPath.c_str(), outPath.c_str());
         return 0;
     }
-    if (extension != ".ply" && extension != ".las" && extension != ".xyz" &&
-        extension != ".txt") {
-        throw UsageError("OUT must end in .ply, .las, .xyz, .txt or .oms, found '" + outPath +
-                         "'");
+    if (extension != ".ply" && extension != ".las" && extension != ".xyz" && extension != ".txt") {
+        throw UsageError("OUT must end in .ply, .las, .xyz, .txt or .oms, found '" + outPath + "'");
     }
     const WholeCloud whole = readWhole(inPath);
     if (extension == ".ply") {
@@ -122,7 +109,7 @@ int runConvert(const std::vector<std::string>& args) {
 const Command& convertCommand() {
     static const Command command{
         "convert", "convert a cloud to PLY, LAS, XYZ or a .oms sorted stream",
-        "convert IN OUT",
+        "convert IN OUT [--memory-budget SIZE] [--temp-dir DIR]",
         "Reads IN (PLY, LAS, XYZ text or .oms) and writes OUT in the format its extension\n"
         "names: .ply (binary little-endian, float coordinates against a 'comment offset'),\n"
         "LAS 1.2 point format 3 (.las, millimetre steps or finer), XYZ text (.xyz, .txt) or a\n"
@@ -130,7 +117,11 @@ const Command& convertCommand() {
         "their colour, normal and intensity where the output format has the field. OUT is\n"
         "replaced atomically.\n"
         "\n"
-        "Exit status: 0 ok, 1 input or output error, 2 usage error.\n",
+        "  --memory-budget SIZE, --temp-dir DIR\n"
+        "               for .oms output, as for 'sort': a sort larger than the budget runs\n"
+        "               on disk (default: OUT's folder) within the budget\n"
+        "\n"
+        "Exit status: 0 ok, 1 input or output error, 2 usage error, 130 interrupted.\n",
         runConvert};
     return command;
 }

@@ -4,6 +4,7 @@
 #include "cli_args.hpp"
 #include "cloud_view.hpp"
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "io/atomic_file_writer.hpp"
 #include "io/input_error.hpp"
 #include "pipeline/build_pipeline.hpp"
@@ -26,10 +27,10 @@ struct CameraChoice {
 };
 
 constexpr CameraChoice kCameras[] = {
-    {"fit", true, StandardView::Iso},       {"iso", false, StandardView::Iso},
-    {"top", false, StandardView::Top},       {"bottom", false, StandardView::Bottom},
-    {"front", false, StandardView::Front},   {"back", false, StandardView::Back},
-    {"left", false, StandardView::Left},     {"right", false, StandardView::Right},
+    {"fit", true, StandardView::Iso},      {"iso", false, StandardView::Iso},
+    {"top", false, StandardView::Top},     {"bottom", false, StandardView::Bottom},
+    {"front", false, StandardView::Front}, {"back", false, StandardView::Back},
+    {"left", false, StandardView::Left},   {"right", false, StandardView::Right},
 };
 
 constexpr std::pair<const char*, RenderMode> kModes[] = {
@@ -39,8 +40,9 @@ constexpr std::pair<const char*, RenderMode> kModes[] = {
 };
 
 constexpr std::pair<const char*, ColorMode> kColors[] = {
-    {"rgb", ColorMode::Rgb},     {"normal", ColorMode::Normal}, {"height", ColorMode::Height},
-    {"intensity", ColorMode::Intensity}, {"level", ColorMode::Level}, {"age", ColorMode::BuildAge},
+    {"rgb", ColorMode::Rgb},       {"normal", ColorMode::Normal},
+    {"height", ColorMode::Height}, {"intensity", ColorMode::Intensity},
+    {"level", ColorMode::Level},   {"age", ColorMode::BuildAge},
 };
 
 QSize parseSize(const std::string& text) {
@@ -55,20 +57,24 @@ QSize parseSize(const std::string& text) {
 
 // Pipelines 1, 2 or 3 by the file's kind: the same driver as `build` and the application.
 std::shared_ptr<const Hierarchy> loadOrBuildHierarchy(const std::string& path,
-                                                      const BuildOptions& options) {
+                                                      const BuildOptions& options,
+                                                      const MemoryOptions& memory) {
     BuildPipeline pipeline;
-    pipeline.run(path, {options, kDefaultSortChunks});
+    runInterruptibly(
+        pipeline, path,
+        {options, kDefaultSortChunks, PointStorage::Exact, memory.budgetBytes, memory.tempDir});
     return pipeline.hierarchy();
 }
 
 int runRender(const std::vector<std::string>& args) {
-    const ParsedArgs parsed = parseArgs(args, {{"camera", true},
-                                               {"size", true},
-                                               {"mode", true},
-                                               {"color", true},
-                                               {"depth", true},
-                                               {"threshold", true},
-                                               {"threads", true}});
+    const ParsedArgs parsed = parseArgs(args, withOptions({{"camera", true},
+                                                           {"size", true},
+                                                           {"mode", true},
+                                                           {"color", true},
+                                                           {"depth", true},
+                                                           {"threshold", true},
+                                                           {"threads", true}},
+                                                          kMemoryOptionSpecs));
     if (parsed.help) {
         printCommandHelp(renderCommand());
         return 0;
@@ -85,7 +91,8 @@ int runRender(const std::vector<std::string>& args) {
         }
         if (camera == nullptr) {
             throw UsageError("--camera takes fit, iso, top, bottom, front, back, left or right, "
-                             "found '" + *name + "'");
+                             "found '" +
+                             *name + "'");
         }
     }
     RenderSettings settings;
@@ -132,12 +139,13 @@ int runRender(const std::vector<std::string>& args) {
                                     static_cast<std::size_t>(threads));
     const std::string& inPath = parsed.positionals[0];
     const std::string& outPath = parsed.positionals[1];
+    const MemoryOptions memory = memoryOptions(parsed, "");
 
     if (std::getenv("DISPLAY") == nullptr && std::getenv("WAYLAND_DISPLAY") == nullptr) {
         throw OutputError(outPath + ": rendering needs a display for its OpenGL context; none is "
                                     "set (headless machines: run under xvfb-run)");
     }
-    const auto hierarchy = loadOrBuildHierarchy(inPath, options);
+    const auto hierarchy = loadOrBuildHierarchy(inPath, options, memory);
 
     int argc = 1;
     char programName[] = "omicron-cli";
@@ -151,7 +159,8 @@ int runRender(const std::vector<std::string>& args) {
     }
     const QImage image = view.renderImage(size);
     if (image.isNull()) {
-        throw OutputError(outPath + ": no OpenGL 3.3 context: " + view.glErrorString().toStdString());
+        throw OutputError(outPath +
+                          ": no OpenGL 3.3 context: " + view.glErrorString().toStdString());
     }
     QByteArray png;
     QBuffer buffer(&png);
@@ -174,8 +183,9 @@ const Command& renderCommand() {
     static const Command command{
         "render", "build a cloud's hierarchy and save an image of it (needs a display)",
         "render IN OUT.png [--camera fit|iso|top|bottom|front|back|left|right] [--size WxH] "
-        "[--mode points|compute|splats] [--color rgb|normal|height|intensity|level|age] [--depth N] "
-        "[--threshold PX] [--threads T]",
+        "[--mode points|compute|splats] [--color rgb|normal|height|intensity|level|age] [--depth "
+        "N] "
+        "[--threshold PX] [--threads T] [--memory-budget SIZE] [--temp-dir DIR]",
         "Runs the pipeline (an unsorted cloud is sorted first; a .oms file is streamed; a .omh\n"
         "hierarchy is loaded), waits for the hierarchy, and renders it with the viewer's\n"
         "CloudView off screen: the front converged at the projection threshold, no point\n"
@@ -190,7 +200,9 @@ const Command& renderCommand() {
         "             intensity, level (hierarchy level of each node), age (build order)\n"
         "  --depth    hierarchy depth (default 7)\n"
         "  --threshold  front projection threshold in pixels: a node whose cell projects larger\n"
-        "             is replaced by its children (default: the viewer's)\n\n"
+        "             is replaced by its children (default: the viewer's)\n"
+        "  --memory-budget SIZE, --temp-dir DIR\n"
+        "             as for 'build': a sort beyond the budget runs on disk ($TMPDIR)\n\n"
         "The OpenGL context needs a display: on a headless machine run it under xvfb-run.\n",
         runRender};
     return command;

@@ -2,13 +2,8 @@
 // order and writes the sorted stream (.oms) while the sorted ranges come out.
 #include "cli_args.hpp"
 #include "commands.hpp"
-#include "formats/oms_writer.hpp"
-#include "io/input_error.hpp"
-#include "io/point_reader.hpp"
-#include "progress_line.hpp"
-#include "sort/morton_sorter.hpp"
+#include "sort_to_oms.hpp"
 
-#include <chrono>
 #include <cstdio>
 #include <tbb/global_control.h>
 
@@ -17,7 +12,8 @@ namespace omicron::cli {
 namespace {
 
 int runSort(const std::vector<std::string>& args) {
-    const ParsedArgs parsed = parseArgs(args, {{"chunks", true}, {"threads", true}});
+    const ParsedArgs parsed =
+        parseArgs(args, withOptions({{"chunks", true}, {"threads", true}}, kMemoryOptionSpecs));
     if (parsed.help) {
         printCommandHelp(sortCommand());
         return 0;
@@ -30,54 +26,23 @@ int runSort(const std::vector<std::string>& args) {
     const std::string& outPath = parsed.positionals[1];
     SortOptions options;
     options.chunks = sortChunksOption(parsed);
+    const MemoryOptions memory = memoryOptions(parsed, outPath);
+    options.memoryBudgetBytes = memory.budgetBytes;
+    options.tempDir = memory.tempDir;
     const int threads = threadsOption(parsed);
     tbb::global_control threadLimit(tbb::global_control::max_allowed_parallelism,
                                     static_cast<std::size_t>(threads));
 
-    using Clock = std::chrono::steady_clock;
-    const auto seconds = [](Clock::time_point since) {
-        return std::chrono::duration<double>(Clock::now() - since).count();
-    };
-    auto reader = openPointCloud(inPath);
-    const std::uint64_t declared = reader->info().pointCount;
-    IncrementalMortonSorter sorter(reader->info(), options);
-    ProgressLine progress;
-    const auto readStart = Clock::now();
-    ReadOptions readOptions;
-    readOptions.batchPoints = options.batchPoints;
-    const ReadSummary read = reader->read(
-        [&](const PointBatch& batch) {
-            sorter.add(batch);
-            progress.update("reading", sorter.pointCount(), declared);
-        },
-        readOptions);
-    const double readSeconds = seconds(readStart);
-
-    const auto sortStart = Clock::now();
-    OmsWriter writer;
-    std::uint64_t written = 0;
-    const int chunksUsed =
-        sorter.sortAndEmit([&](const SortedCloud& cloud, std::size_t begin, std::size_t end) {
-            if (written == 0) {
-                writer.open(outPath, cloud.cube(), cloud.sourceOffset(), cloud.attributes(),
-                            sorter.pointCount());
-            }
-            writer.append(cloud, begin, end);
-            written += end - begin;
-            progress.update("sorted and written", written, sorter.pointCount());
-        });
-    if (written == 0) {
-        throw InputError(InputErrorKind::NoPoints, inPath, InputLocation::none(),
-                         "no finite point to sort");
-    }
-    writer.finish();
-    progress.finish();
+    const SortToOmsResult sorted = sortToOms(inPath, outPath, options);
     std::printf("sorted %llu points (%llu non-finite skipped) into %s: read %.3f s, first "
-                "sorted batch %.3f s after reading, sort and write %.3f s, %d chunks, "
+                "sorted batch %.3f s after reading, sort and write %.3f s, %d %s, "
                 "%d threads\n",
-                static_cast<unsigned long long>(written),
-                static_cast<unsigned long long>(read.skippedNonFinite), outPath.c_str(),
-                readSeconds, sorter.firstRangeSeconds(), seconds(sortStart), chunksUsed, threads);
+                static_cast<unsigned long long>(sorted.written),
+                static_cast<unsigned long long>(sorted.skippedNonFinite), outPath.c_str(),
+                sorted.readSeconds, sorted.firstSortedSeconds, sorted.sortSeconds, sorted.chunks,
+                sorted.spilled ? "runs merged (spilled to the scratch folder, now removed)"
+                               : "chunks",
+                threads);
     return 0;
 }
 
@@ -86,7 +51,7 @@ int runSort(const std::vector<std::string>& args) {
 const Command& sortCommand() {
     static const Command command{
         "sort", "sort a cloud in Morton order into a sorted stream file (.oms)",
-        "sort IN OUT.oms [--chunks K] [--threads T]",
+        "sort IN OUT.oms [--chunks K] [--threads T] [--memory-budget SIZE] [--temp-dir DIR]",
         "Reads IN (PLY, LAS or XYZ), sorts its points by their level-21 Morton code in the\n"
         "cube of its bounding box (origin = min corner, edge = largest extent) and writes the\n"
         "sorted stream OUT.oms (docs/FORMATS.md) while sorted chunks come out. OUT is written\n"
@@ -95,8 +60,17 @@ const Command& sortCommand() {
         "  --chunks K   sort chunks, 1..256 (default 32): more chunks give the first sorted\n"
         "               batch sooner after reading ends\n"
         "  --threads T  worker threads (default: all cores)\n"
+        "  --memory-budget SIZE\n"
+        "               what the sort may keep resident, e.g. 512M or 4G (default: half of\n"
+        "               physical memory). A cloud whose in-memory sort needs more (about 43\n"
+        "               bytes a point with colour) is sorted in runs on disk, which are then\n"
+        "               merged straight into OUT: memory stays within the budget at any size\n"
+        "  --temp-dir DIR\n"
+        "               where the runs go (default: OUT's folder); they need about the\n"
+        "               size of OUT and are removed on success, error and Ctrl+C\n"
         "\n"
-        "Progress goes to stderr. Exit status: 0 ok, 1 input or output error, 2 usage error.\n",
+        "Progress goes to stderr. Exit status: 0 ok, 1 input or output error (a full scratch\n"
+        "disk names the folder and the bytes needed), 2 usage error, 130 interrupted.\n",
         runSort};
     return command;
 }

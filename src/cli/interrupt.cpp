@@ -1,7 +1,9 @@
 #include "interrupt.hpp"
 
+#include <chrono>
 #include <csignal>
 #include <mutex>
+#include <thread>
 
 namespace omicron::cli {
 
@@ -33,6 +35,26 @@ void throwIfInterrupted() {
     if (g_interrupted.load(std::memory_order_relaxed)) {
         throw Interrupted();
     }
+}
+
+PipelineResult runInterruptibly(BuildPipeline& pipeline, const std::string& path,
+                                const PipelineOptions& options) {
+    const std::atomic<bool>& interrupted = watchInterrupts();
+    // The pipeline has its own cancel flag; a watcher hands the signal over.
+    std::jthread watcher([&](std::stop_token stop) {
+        while (!stop.stop_requested()) {
+            if (interrupted.load(std::memory_order_relaxed)) {
+                pipeline.cancel();
+                return;
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+    });
+    PipelineResult result = pipeline.run(path, options);
+    watcher.request_stop();
+    watcher.join();
+    throwIfInterrupted();
+    return result;
 }
 
 } // namespace omicron::cli

@@ -4,8 +4,11 @@
 // with status 130. A second signal ends the process at once, as it would without handlers.
 #pragma once
 
+#include "pipeline/build_pipeline.hpp"
+
 #include <atomic>
 #include <stdexcept>
+#include <string>
 
 namespace omicron::cli {
 
@@ -19,5 +22,10 @@ const std::atomic<bool>& watchInterrupts();
 
 // Throws Interrupted once a watched signal arrived.
 void throwIfInterrupted();
+
+// pipeline.run(path, options) with Ctrl+C watched: a signal cancels the run (the pipeline
+// stops at its next batch, chunk or level), which then throws Interrupted.
+PipelineResult runInterruptibly(BuildPipeline& pipeline, const std::string& path,
+                                const PipelineOptions& options);
 
 } // namespace omicron::cli

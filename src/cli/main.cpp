@@ -23,9 +23,9 @@ constexpr int kExitInterrupted = 130; // 128 + SIGINT, as shells report it
 
 const std::array<const Command*, 9>& commands() {
     static const std::array<const Command*, 9> all{
-        &omicron::cli::infoCommand(),    &omicron::cli::generateCommand(),
-        &omicron::cli::sortCommand(),    &omicron::cli::exportCommand(),
-        &omicron::cli::buildCommand(),   &omicron::cli::convertCommand(),
+        &omicron::cli::infoCommand(),         &omicron::cli::generateCommand(),
+        &omicron::cli::sortCommand(),         &omicron::cli::exportCommand(),
+        &omicron::cli::buildCommand(),        &omicron::cli::convertCommand(),
         &omicron::cli::exportPotreeCommand(), &omicron::cli::renderCommand(),
         &omicron::cli::tileCommand()};
     return all;

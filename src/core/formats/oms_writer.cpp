@@ -132,6 +132,35 @@ void OmsWriter::append(const SortedCloud& cloud, std::size_t begin, std::size_t 
     m_pointsWritten = end;
 }
 
+void OmsWriter::append(const PointBatch& sorted) {
+    if (!m_file) {
+        throw OutputError(m_path + ": OmsWriter::append() without a successful open()");
+    }
+    if (sorted.attributes != m_attributes) {
+        fail("the appended batch has attribute bits " + std::to_string(sorted.attributes.bits()) +
+             ", the file was opened with " + std::to_string(m_attributes.bits()));
+    }
+    if (sorted.size() > m_pointCount - m_pointsWritten) {
+        fail("appending " + std::to_string(sorted.size()) + " points after " +
+             std::to_string(m_pointsWritten) + " exceeds the " + std::to_string(m_pointCount) +
+             " points declared at open()");
+    }
+    m_block.resize(sorted.size() * m_layout.bytes);
+    for (std::size_t i = 0; i < sorted.size(); ++i) {
+        const glm::vec3 p = sorted.positions[i];
+        const morton::Code code = morton::encodeUnit(p.x, p.y, p.z);
+        if (code < m_lastCode) {
+            fail("point " + std::to_string(m_pointsWritten + i) +
+                 " is out of Morton order: the stream is not sorted");
+        }
+        m_lastCode = code;
+        encodePointRecord(m_layout, sorted, i, m_block.data() + i * m_layout.bytes);
+    }
+    m_checksum->update(m_block.data(), m_block.size());
+    m_file->write(m_block.data(), m_block.size());
+    m_pointsWritten += sorted.size();
+}
+
 void OmsWriter::finish() {
     if (!m_file) {
         throw OutputError(m_path + ": OmsWriter::finish() without a successful open()");

@@ -39,6 +39,11 @@ public:
     // (what a reader will see) must be non-decreasing across all ranges.
     void append(const SortedCloud& cloud, std::size_t begin, std::size_t end);
 
+    // Appends the next points of a sorted stream (the attributes given to open()), as a sort
+    // larger than memory emits them (IncrementalMortonSorter::emitSortedBatches); the same
+    // order check as above.
+    void append(const PointBatch& sorted);
+
     // Writes the footer and renames the temporary file onto the target.
     void finish();
 

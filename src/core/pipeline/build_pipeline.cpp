@@ -240,6 +240,8 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
     sortOptions.chunks = options.sortChunks;
     sortOptions.cancel = &m_cancel;
     sortOptions.storage = options.storage;
+    sortOptions.memoryBudgetBytes = options.memoryBudgetBytes;
+    sortOptions.tempDir = options.tempDir;
     auto sorter = std::make_shared<IncrementalMortonSorter>(info, sortOptions);
     PipelineResult result;
     result.pipeline = toString(PipelineKind::UnsortedCloud);
@@ -276,6 +278,7 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
         const auto sortStart = Clock::now();
         sorter->sortAndEmit(builder->consumer());
         result.sortSeconds = secondsSince(sortStart);
+        result.sortRuns = sorter->runCount();
     }
     {
         // The sorter's unsorted copy of the input is as large as the cloud: let it go.
@@ -342,6 +345,8 @@ PipelineResult BuildPipeline::runGeneratedScene(std::uint64_t points, std::uint6
     sortOptions.chunks = options.sortChunks;
     sortOptions.cancel = &m_cancel;
     sortOptions.storage = options.storage;
+    sortOptions.memoryBudgetBytes = options.memoryBudgetBytes;
+    sortOptions.tempDir = options.tempDir;
     auto sorter = std::make_shared<IncrementalMortonSorter>(info, sortOptions);
     PipelineResult result;
     result.pipeline = toString(PipelineKind::GeneratedScene);
@@ -375,6 +380,7 @@ PipelineResult BuildPipeline::runGeneratedScene(std::uint64_t points, std::uint6
         const auto sortStart = Clock::now();
         sorter->sortAndEmit(builder->consumer());
         result.sortSeconds = secondsSince(sortStart);
+        result.sortRuns = sorter->runCount();
     }
     {
         std::lock_guard lock(m_mutex);

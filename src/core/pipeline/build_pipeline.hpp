@@ -91,6 +91,7 @@ struct PipelineResult {
     BuildStatistics stats;
     double readSeconds = 0.0; // streaming the points (and, for .oms, the sorted ranges)
     double sortSeconds = 0.0; // sorter emission after the read; 0 for .oms and rebuild
+    std::size_t sortRuns = 0; // runs spilled to disk and merged (0: sorted in memory)
     std::uint64_t skippedNonFinite = 0;
     bool cancelled = false;
     std::string pipeline; // human-readable, e.g. "unsorted cloud -> incremental sorter -> builder"
@@ -102,6 +103,12 @@ struct PipelineOptions {
     // How the sorted cloud keeps positions and colours (pipelines 1 and 2; a rebuild keeps the
     // cloud it has).
     PointStorage storage = PointStorage::Exact;
+    // What the sort may keep resident (0: defaultMemoryBudget()); beyond it, pipeline 1 sorts
+    // in runs on disk under `tempDir` (empty: $TMPDIR or /tmp) and merges them into the cloud.
+    // The sorted cloud itself stays resident for the builder (15 bytes a point exact, about 7
+    // packed).
+    std::uint64_t memoryBudgetBytes = 0;
+    std::string tempDir = {};
 };
 
 // Points and seed of the built-in default scene when a front end shows it at start-up.

@@ -46,7 +46,7 @@ struct SortOptions {
     // What the sort may keep resident (0: defaultMemoryBudget()); a cloud whose in-memory sort
     // needs more is sorted in runs on disk, under `tempDir` (empty: $TMPDIR or /tmp).
     std::uint64_t memoryBudgetBytes = 0;
-    std::string tempDir;
+    std::string tempDir = {};
 };
 
 // Receives [begin, end) of `cloud`, already published: every code in it is >= every code of

@@ -1,0 +1,146 @@
+// Pipeline 1 under a memory budget that forces the sort onto disk: the hierarchy equals the
+// in-memory build node for node (structure, held points, splats) for the shared scans, the
+// adversarial shapes and the generated scene, with the invariants checked after every pass;
+// the runs are gone after the build and after a cancel.
+#include "hierarchy_test_support.hpp"
+#include "io/ply/ply_writer.hpp"
+#include "memory_budget.hpp"
+#include "pipeline/build_pipeline.hpp"
+#include "test_files.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <filesystem>
+#include <gtest/gtest.h>
+#include <string>
+#include <thread>
+
+namespace omicron {
+namespace {
+
+PipelineOptions options(std::uint64_t budget, const std::string& tempDir,
+                        LeafCollapse collapse = LeafCollapse::Off) {
+    PipelineOptions o;
+    o.build.maxLevel = 7;
+    o.build.collapse = collapse;
+    o.build.checkInvariants = true;
+    o.memoryBudgetBytes = budget;
+    o.tempDir = tempDir;
+    return o;
+}
+
+std::size_t entriesIn(const std::filesystem::path& folder) {
+    return static_cast<std::size_t>(std::distance(std::filesystem::directory_iterator(folder), {}));
+}
+
+struct Built {
+    PipelineResult result;
+    std::uint64_t print = 0;
+};
+
+Built build(const std::string& path, const PipelineOptions& o, bool withSplats) {
+    BuildPipeline pipeline;
+    Built built;
+    built.result = pipeline.run(path, o);
+    EXPECT_TRUE(built.result.stats.complete);
+    EXPECT_TRUE(built.result.stats.invariantViolation.empty())
+        << built.result.stats.invariantViolation;
+    built.print = test::fingerprint(*pipeline.hierarchy(), withSplats);
+    return built;
+}
+
+void expectSameBuild(const std::string& path, LeafCollapse collapse, bool withSplats) {
+    test::TempDir scratch;
+    const Built inMemory = build(path, options(0, scratch.path().string(), collapse), withSplats);
+    EXPECT_EQ(inMemory.result.sortRuns, 0u);
+    const Built spilled =
+        build(path, options(kMinMemoryBudget, scratch.path().string(), collapse), withSplats);
+    EXPECT_GT(spilled.result.sortRuns, 1u);
+    EXPECT_EQ(spilled.print, inMemory.print) << "the hierarchies differ";
+    ASSERT_EQ(spilled.result.stats.levels.size(), inMemory.result.stats.levels.size());
+    for (std::size_t level = 0; level < inMemory.result.stats.levels.size(); ++level) {
+        EXPECT_EQ(spilled.result.stats.levels[level].nodes,
+                  inMemory.result.stats.levels[level].nodes);
+        EXPECT_EQ(spilled.result.stats.levels[level].points,
+                  inMemory.result.stats.levels[level].points);
+    }
+    EXPECT_EQ(entriesIn(scratch.path()), 0u) << "the runs outlived the build";
+}
+
+class BudgetedBuild : public testing::TestWithParam<std::string> {};
+
+TEST_P(BudgetedBuild, SpilledSortBuildsTheSameHierarchyNodeForNode) {
+    OMICRON_REQUIRE_SHARED_FILE(path, GetParam());
+    expectSameBuild(path, LeafCollapse::Off, GetParam() == "lion.ply");
+}
+
+INSTANTIATE_TEST_SUITE_P(Files, BudgetedBuild,
+                         testing::Values("autzen_trim.las", "lion.ply", "dragon.ply",
+                                         "sorvilier.ply", "indoor.ply"),
+                         test::FileParamName{});
+
+TEST(BudgetedBuild, PaperCollapseToo) {
+    OMICRON_REQUIRE_SHARED_FILE(path, "dragon.ply");
+    expectSameBuild(path, LeafCollapse::Paper, false);
+}
+
+class BudgetedBuildShapes : public testing::TestWithParam<test::Shape> {};
+
+TEST_P(BudgetedBuildShapes, AdversarialCloudsBuildTheSameHierarchy) {
+    const test::SyntheticCloud cloud = test::makeCloud(GetParam(), 250'000, 11);
+    test::TempDir dir;
+    const std::string path = dir.file("cloud.ply");
+    writePly(path, cloud.points, CubeTransform{glm::dvec3(0.0), 100.0});
+    expectSameBuild(path, LeafCollapse::Off, false);
+}
+
+INSTANTIATE_TEST_SUITE_P(Shapes, BudgetedBuildShapes,
+                         testing::Values(test::Shape::Random, test::Shape::Duplicates,
+                                         test::Shape::AllIdentical, test::Shape::TwoClusters,
+                                         test::Shape::MaxFaces, test::Shape::Plane,
+                                         test::Shape::Line),
+                         [](const auto& info) {
+                             std::string name = test::toString(info.param);
+                             std::replace(name.begin(), name.end(), ' ', '_');
+                             return name;
+                         });
+
+TEST(BudgetedBuild, GeneratedSceneSpillsTheSame) {
+    test::TempDir scratch;
+    BuildPipeline inMemory;
+    inMemory.runGeneratedScene(400'000, 5, options(0, scratch.path().string()));
+    BuildPipeline spilled;
+    const PipelineResult result =
+        spilled.runGeneratedScene(400'000, 5, options(kMinMemoryBudget, scratch.path().string()));
+    EXPECT_GT(result.sortRuns, 1u);
+    EXPECT_EQ(test::fingerprint(*spilled.hierarchy(), false),
+              test::fingerprint(*inMemory.hierarchy(), false));
+    EXPECT_EQ(entriesIn(scratch.path()), 0u);
+}
+
+// Cancelled while the runs are merged into the builder: the run returns cancelled, and the
+// runs are removed with the sorter.
+TEST(BudgetedBuild, CancelDuringTheMergeRemovesTheRuns) {
+    OMICRON_REQUIRE_SHARED_FILE(path, "indoor.ply");
+    test::TempDir scratch;
+    BuildPipeline pipeline;
+    std::atomic<bool> stop{false};
+    std::thread canceller([&] {
+        while (!stop.load()) {
+            if (pipeline.progress().phase == BuildPhase::Sorting) {
+                pipeline.cancel();
+                return;
+            }
+            std::this_thread::yield();
+        }
+    });
+    const PipelineResult result =
+        pipeline.run(path, options(kMinMemoryBudget, scratch.path().string()));
+    stop.store(true);
+    canceller.join();
+    EXPECT_TRUE(result.cancelled);
+    EXPECT_EQ(entriesIn(scratch.path()), 0u);
+}
+
+} // namespace
+} // namespace omicron
