@@ -1,7 +1,9 @@
 #include "build_panel.hpp"
 
+#include "memory_budget.hpp"
 #include "ui_buildpanel.h"
 
+#include <QFileDialog>
 #include <QSettings>
 #include <algorithm>
 #include <iterator>
@@ -38,6 +40,13 @@ BuildPanel::BuildPanel(QWidget* parent)
     setViewParameters(ViewParameters{});
     connect(m_ui->rebuildButton, &QPushButton::clicked, this, &BuildPanel::requestRebuild);
     connect(m_ui->cancelButton, &QPushButton::clicked, this, &BuildPanel::cancelRequested);
+    connect(m_ui->tempDirButton, &QToolButton::clicked, this, [this] {
+        const QString folder = QFileDialog::getExistingDirectory(
+            this, tr("Scratch folder for sorted runs"), m_ui->tempDirEdit->text());
+        if (!folder.isEmpty()) {
+            m_ui->tempDirEdit->setText(folder);
+        }
+    });
     const auto viewEdited = [this] {
         emit viewParametersChanged(viewParameters());
     };
@@ -57,6 +66,10 @@ PipelineOptions BuildPanel::pipelineOptions() const {
     options.build.threads = m_ui->threadsSpin->value();
     options.sortChunks = m_ui->chunksSpin->value();
     options.storage = static_cast<PointStorage>(m_ui->storeCombo->currentIndex());
+    // 0 is automatic; anything else at least the pipeline's minimum.
+    const std::uint64_t budgetMiB = static_cast<std::uint64_t>(m_ui->memoryBudgetSpin->value());
+    options.memoryBudgetBytes = budgetMiB == 0 ? 0 : std::max(budgetMiB * kMiB, kMinMemoryBudget);
+    options.tempDir = m_ui->tempDirEdit->text().trimmed().toStdString();
     return options;
 }
 
@@ -68,6 +81,12 @@ void BuildPanel::setPipelineOptions(const PipelineOptions& options) {
     m_ui->threadsSpin->setValue(options.build.threads);
     m_ui->chunksSpin->setValue(options.sortChunks);
     m_ui->storeCombo->setCurrentIndex(static_cast<int>(options.storage));
+    // 0 (automatic) or whole MiB, at least the pipeline's minimum.
+    const std::uint64_t budgetMiB = options.memoryBudgetBytes / kMiB;
+    m_ui->memoryBudgetSpin->setValue(budgetMiB == 0 ? 0
+                                                    : static_cast<int>(std::max<std::uint64_t>(
+                                                          kMinMemoryBudget / kMiB, budgetMiB)));
+    m_ui->tempDirEdit->setText(QString::fromStdString(options.tempDir));
 }
 
 ViewParameters BuildPanel::viewParameters() const {
@@ -99,6 +118,8 @@ void BuildPanel::loadSettings(const QSettings& settings) {
     options.build.threads = settings.value("build/threads", 0).toInt();
     options.sortChunks = settings.value("build/sortChunks", defaults.sortChunks).toInt();
     parsePointStorage(settings.value("build/pointStore").toString().toStdString(), options.storage);
+    options.memoryBudgetBytes = settings.value("build/memoryBudgetMiB", 0).toULongLong() * kMiB;
+    options.tempDir = settings.value("build/tempDir").toString().toStdString();
     setPipelineOptions(options);
     const ViewParameters viewDefaults;
     ViewParameters view;
@@ -126,6 +147,8 @@ void BuildPanel::saveSettings(QSettings& settings) const {
     settings.setValue("build/threads", options.build.threads);
     settings.setValue("build/sortChunks", options.sortChunks);
     settings.setValue("build/pointStore", QLatin1String(toString(options.storage)));
+    settings.setValue("build/memoryBudgetMiB", qulonglong(options.memoryBudgetBytes / kMiB));
+    settings.setValue("build/tempDir", QString::fromStdString(options.tempDir));
     const ViewParameters view = viewParameters();
     settings.setValue("view/projectionThresholdPx", view.projectionThresholdPx);
     settings.setValue("view/pointBudget", qulonglong(view.pointBudget));

@@ -171,9 +171,16 @@ int CutPanel::barValue(int bar) const {
 }
 
 void CutPanel::setProgress(const PipelineProgress& progress) {
-    m_ui->phaseLabel->setText(progress.scanningBounds()
-                                  ? tr("opening: scanning the file for its bounds")
-                                  : QString::fromLatin1(toString(progress.phase)));
+    QString phase = QString::fromLatin1(toString(progress.phase));
+    if (progress.scanningBounds()) {
+        phase = tr("opening: scanning the file for its bounds");
+    } else if (progress.sortRuns > 0 && progress.phase == BuildPhase::Reading) {
+        phase = tr("reading: beyond the memory budget, %n sorted run(s) spilled to disk", "",
+                   static_cast<int>(progress.sortRuns));
+    } else if (progress.sortRuns > 0 && progress.phase == BuildPhase::Sorting) {
+        phase = tr("merging %n sorted run(s) from disk", "", static_cast<int>(progress.sortRuns));
+    }
+    m_ui->phaseLabel->setText(phase);
     const std::uint64_t total = progress.pointsTotal;
     if (progress.scanningBounds()) {
         // PLY and XYZ files are read once for their bounds before any point streams.

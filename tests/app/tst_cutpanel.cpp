@@ -10,6 +10,7 @@
 #include "widget_test_support.hpp"
 
 #include <QAbstractItemModelTester>
+#include <QLabel>
 #include <QLocale>
 #include <QSignalSpy>
 #include <QTreeView>
@@ -38,6 +39,7 @@ private slots:
     void selectingANodeShowsItsDetailsAndEmitsIt();
     void selectionFollowsItsRowWhileABuildRuns();
     void readBarShowsTheBoundsPrePass();
+    void phaseSaysWhenTheSortSpillsAndMerges();
 };
 
 void TestCutPanel::selectingANodeShowsItsDetailsAndEmitsIt() {
@@ -155,6 +157,28 @@ void TestCutPanel::readBarShowsTheBoundsPrePass() {
     panel.setProgress(progress);
     QCOMPARE(panel.barValue(0), 100);
     QVERIFY(!panel.barText(0).contains(QStringLiteral("scanning")));
+}
+
+void TestCutPanel::phaseSaysWhenTheSortSpillsAndMerges() {
+    CutPanel panel;
+    auto* phase = panel.findChild<QLabel*>(QStringLiteral("phaseLabel"));
+    QVERIFY(phase != nullptr);
+    PipelineProgress progress;
+    progress.generation = 1;
+    progress.phase = BuildPhase::Reading;
+    progress.pointsTotal = 1000;
+    panel.setProgress(progress);
+    QCOMPARE(phase->text(), QStringLiteral("reading"));
+    progress.sortRuns = 3;
+    panel.setProgress(progress);
+    QCOMPARE(phase->text(),
+             QStringLiteral("reading: beyond the memory budget, 3 sorted run(s) spilled to disk"));
+    progress.phase = BuildPhase::Sorting;
+    panel.setProgress(progress);
+    QCOMPARE(phase->text(), QStringLiteral("merging 3 sorted run(s) from disk"));
+    progress.sortRuns = 0;
+    panel.setProgress(progress);
+    QCOMPARE(phase->text(), QStringLiteral("sorting"));
 }
 
 QTEST_MAIN(TestCutPanel)

@@ -11,21 +11,25 @@
 #include "hierarchy_model.hpp"
 #include "level_model.hpp"
 #include "main_window.hpp"
+#include "memory_budget.hpp"
 #include "time_series_chart.hpp"
 #include "widget_test_support.hpp"
 
 #include <QAbstractItemModelTester>
 #include <QAction>
 #include <QComboBox>
+#include <QDir>
 #include <QElapsedTimer>
 #include <QFile>
 #include <QFileInfo>
 #include <QImage>
 #include <QLabel>
+#include <QLineEdit>
 #include <QLineSeries>
 #include <QMessageBox>
 #include <QSettings>
 #include <QSignalSpy>
+#include <QSpinBox>
 #include <QStandardPaths>
 #include <QSurfaceFormat>
 #include <QTemporaryDir>
@@ -65,6 +69,7 @@ private slots:
     void malformedFileShowsANamedErrorAndTheAppStaysUsable();
     void savedHierarchyOpensThroughTheFileMenu();
     void closingMidBuildReturnsPromptly();
+    void aCloudBeyondTheMemoryBudgetSortsOnDisk();
     void renderModeMenuAndPanelDriveTheView();
     void hierarchyTreeSelectionHighlightsTheNodeInTheView();
 };
@@ -225,6 +230,52 @@ void TestMainWindowGL::savedHierarchyOpensThroughTheFileMenu() {
         QCOMPARE(loaded.stats.levels[level].points, built.stats.levels[level].points);
     }
     QTRY_VERIFY(window.cloudView()->hierarchy() == window.service()->hierarchy());
+}
+
+// The panel's memory budget and scratch folder apply to the next open: a budget below the
+// cloud's in-memory sort spills runs to the chosen folder, the hierarchy is the same, no run is
+// left, and both settings come back in the next window.
+void TestMainWindowGL::aCloudBeyondTheMemoryBudgetSortsOnDisk() {
+    OMICRON_REQUIRE_SHARED_FILE(path, "lion.ply");
+    QTemporaryDir scratch;
+    {
+        MainWindow window;
+        window.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        QSignalSpy finished(window.service(), &BuilderService::buildFinished);
+        window.openFile(path);
+        QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 1, kBuildTimeoutMs);
+        QTRY_VERIFY(!window.service()->busy());
+        const auto inMemory = finished.last().at(0).value<PipelineResult>();
+        QCOMPARE(inMemory.sortRuns, std::size_t{0});
+
+        auto* budget =
+            window.buildPanel()->findChild<QSpinBox*>(QStringLiteral("memoryBudgetSpin"));
+        auto* folder = window.buildPanel()->findChild<QLineEdit*>(QStringLiteral("tempDirEdit"));
+        QVERIFY(budget != nullptr && folder != nullptr);
+        QCOMPARE(budget->text(), QStringLiteral("automatic (half of RAM)"));
+        budget->setValue(4);
+        folder->setText(scratch.path());
+        window.openFile(path);
+        QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 2, kBuildTimeoutMs);
+        QTRY_VERIFY(!window.service()->busy());
+        const auto spilled = finished.last().at(0).value<PipelineResult>();
+        QVERIFY2(spilled.sortRuns > 1, qPrintable(QString::number(spilled.sortRuns)));
+        QVERIFY(spilled.stats.complete);
+        QCOMPARE(spilled.stats.totalNodes(), inMemory.stats.totalNodes());
+        QCOMPARE(spilled.stats.levels.back().points, inMemory.stats.levels.back().points);
+        QVERIFY(QDir(scratch.path()).isEmpty());
+        window.close();
+    }
+    MainWindow again;
+    QCOMPARE(again.buildPanel()->pipelineOptions().memoryBudgetBytes, 4 * kMiB);
+    QCOMPARE(again.buildPanel()->pipelineOptions().tempDir, scratch.path().toStdString());
+    // Back to automatic for the other tests.
+    PipelineOptions automatic = again.buildPanel()->pipelineOptions();
+    automatic.memoryBudgetBytes = 0;
+    automatic.tempDir.clear();
+    again.buildPanel()->setPipelineOptions(automatic);
+    again.close();
 }
 
 void TestMainWindowGL::closingMidBuildReturnsPromptly() {

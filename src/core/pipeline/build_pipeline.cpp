@@ -178,6 +178,7 @@ void BuildPipeline::beginRun(BuildPhase phase) {
     m_pointsRead.store(0);
     m_bytesScanned.store(0);
     m_bytesToScan.store(0);
+    m_sortRuns.store(0);
     m_generation.fetch_add(1);
     setPhase(phase);
 }
@@ -268,6 +269,7 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
         [&](const PointBatch& batch) {
             sorter->add(batch);
             m_pointsRead.fetch_add(batch.size(), std::memory_order_relaxed);
+            m_sortRuns.store(sorter->runCount(), std::memory_order_relaxed);
         },
         readOptions);
     result.readSeconds = secondsSince(readStart);
@@ -373,6 +375,7 @@ PipelineResult BuildPipeline::runGeneratedScene(std::uint64_t points, std::uint6
         copySlice(scene.points, begin, end, batch);
         sorter->add(batch);
         m_pointsRead.fetch_add(batch.size(), std::memory_order_relaxed);
+        m_sortRuns.store(sorter->runCount(), std::memory_order_relaxed);
     }
     result.readSeconds = secondsSince(readStart);
     if (!cancelled()) {
@@ -431,6 +434,7 @@ PipelineProgress BuildPipeline::progress() const {
     progress.pointsRead = m_pointsRead.load(std::memory_order_relaxed);
     progress.bytesToScan = m_bytesToScan.load(std::memory_order_relaxed);
     progress.bytesScanned = m_bytesScanned.load(std::memory_order_relaxed);
+    progress.sortRuns = m_sortRuns.load(std::memory_order_relaxed);
     std::shared_ptr<HierarchyBuilder> builder;
     std::shared_ptr<const SortedCloud> cloud;
     {

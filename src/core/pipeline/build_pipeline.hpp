@@ -70,6 +70,10 @@ struct PipelineProgress {
     std::uint64_t bytesScanned = 0;
     std::uint64_t bytesToScan = 0;
 
+    // Pipeline 1 beyond the memory budget: sorted runs spilled to disk so far (read phase),
+    // then merged (sorting phase); 0 when the sort fits in memory.
+    std::uint64_t sortRuns = 0;
+
     // Opening a file that is being scanned for its bounds: no point is read yet.
     bool scanningBounds() const { return phase == BuildPhase::Opening && bytesToScan > 0; }
 };
@@ -195,6 +199,7 @@ private:
     std::atomic<std::uint64_t> m_bytesToScan{0};
     std::atomic<std::uint64_t> m_generation{0};
     std::atomic<std::uint64_t> m_sourceReads{0};
+    std::atomic<std::uint64_t> m_sortRuns{0};
     std::atomic<bool> m_running{false};
 
     mutable std::mutex m_mutex; // guards the shared pointers and the source below
