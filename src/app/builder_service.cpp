@@ -158,6 +158,7 @@ void BuilderService::startJob(Job job) {
         m_buildClock.start();
         m_lastProgress = {};
         m_lastPreviewPoints = 0;
+        m_lastPreviewProvisional = false;
         emit buildStarted(job.title);
         m_poll.start();
     }
@@ -240,12 +241,19 @@ void BuilderService::poll() {
         m_lastHierarchy = hierarchy;
         emit hierarchyChanged(hierarchy);
     }
-    if (progress.phase == BuildPhase::Reading) {
+    if (progress.phase == BuildPhase::Reading || progress.scanningBounds()) {
+        // While a PLY or XYZ file is scanned for its bounds, the scan's own sample in a
+        // provisional frame; from the read on, the sorter's.
         PreviewSample preview = m_pipeline->preview();
         const auto source = m_pipeline->source();
-        if (source && preview.pointsSeen != m_lastPreviewPoints && !preview.positions.empty()) {
+        const bool usable =
+            preview.provisional || (progress.phase == BuildPhase::Reading && source.has_value());
+        if (usable && !preview.positions.empty() &&
+            (preview.pointsSeen != m_lastPreviewPoints ||
+             preview.provisional != m_lastPreviewProvisional)) {
             m_lastPreviewPoints = preview.pointsSeen;
-            emit previewChanged(preview, source->cube);
+            m_lastPreviewProvisional = preview.provisional;
+            emit previewChanged(preview, source ? source->cube : CubeTransform{});
         }
     }
     if (progress.generation == m_staleGeneration) {

@@ -130,6 +130,7 @@ private:
     PipelineProgress m_lastProgress;
     std::uint64_t m_staleGeneration = 0;
     std::uint64_t m_lastPreviewPoints = 0;
+    bool m_lastPreviewProvisional = false;
 };
 
 } // namespace omicron

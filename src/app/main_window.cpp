@@ -480,9 +480,12 @@ void MainWindow::updateStatus() {
     m_phaseLabel->setText(m_progress.scanningBounds()
                               ? tr("scanning bounds")
                               : QString::fromLatin1(toString(m_progress.phase)));
-    m_pointsLabel->setText(tr("%1 / %2 points")
-                               .arg(locale.toString(quint64(m_pointsDrawn)),
-                                    locale.toString(quint64(m_progress.pointsTotal))));
+    // Before the source is open (an XYZ file's bounds scan) its count is not known yet.
+    m_pointsLabel->setText(m_progress.pointsTotal == 0
+                               ? tr("%1 points drawn").arg(locale.toString(quint64(m_pointsDrawn)))
+                               : tr("%1 / %2 points")
+                                     .arg(locale.toString(quint64(m_pointsDrawn)),
+                                          locale.toString(quint64(m_progress.pointsTotal))));
     // The view draws on demand: with nothing changing for a while it is idle, not slow.
     constexpr qint64 kIdleMs = 1500;
     m_fpsLabel->setText(m_lastFrame.isValid() && m_lastFrame.elapsed() < kIdleMs

@@ -63,6 +63,7 @@ private slots:
     void savedHierarchyLoadsBackWithIdenticalStatistics();
     void cancelMidBuildEndsTheRun();
     void cancelDuringTheBoundsPrePassKeepsThePreviousCloud();
+    void firstPixelsComeFromTheBoundsPrePass();
     void destroyingMidBuildJoinsEveryThread();
     void newOpenWhileBusyReplacesTheRunningBuild();
 };
@@ -272,6 +273,52 @@ void TestBuilderService::cancelMidBuildEndsTheRun() {
 // cancelled, the file was never read into the sorter, and the previous cloud and hierarchy
 // stay. The worker waits inside the scan until the GUI thread has seen the scan in the
 // progress signal and pressed Cancel, so the order does not depend on timing.
+// A PLY has no bounds in its header: while the file is scanned for them, the preview is the
+// scan's own sample in a provisional frame (the scan is held mid-file here until that preview
+// has arrived). (The sorter's preview follows while reading, when a poll falls in it.)
+void TestBuilderService::firstPixelsComeFromTheBoundsPrePass() {
+    QTemporaryDir dir;
+    const QString path = dir.filePath(QStringLiteral("scan.ply"));
+    PlyWriteOptions ascii;
+    ascii.encoding = PlyEncoding::Ascii; // about 10 MB: ten blocks of scanning
+    const GeneratedScene scene = generateScene(150'000, 3);
+    writePly(path.toStdString(), scene.points, scene.cube, ascii);
+
+    std::mutex mutex;
+    std::condition_variable released;
+    bool release = false;
+    std::atomic<int> reports{0};
+    BuilderService service; // after what its worker's observer uses: destroyed first
+    service.setOptions(testOptions(6));
+    QSignalSpy finished(&service, &BuilderService::buildFinished);
+    QSignalSpy failed(&service, &BuilderService::failed);
+    QSignalSpy previews(&service, &BuilderService::previewChanged);
+    service.setPrePassObserver([&](std::uint64_t, std::uint64_t) {
+        if (++reports == 4) { // three blocks sampled, most of the file still to scan
+            std::unique_lock lock(mutex);
+            released.wait_for(lock, std::chrono::seconds(60), [&] { return release; });
+        }
+    });
+    service.open(path);
+    QTRY_VERIFY_WITH_TIMEOUT(!previews.isEmpty(), kBuildTimeoutMs);
+    const auto first = previews.first().at(0).value<PreviewSample>();
+    QVERIFY(first.provisional);
+    QVERIFY(first.positions.size() > 1000);
+    for (const glm::vec3& p : first.positions) {
+        QVERIFY(p.x >= 0.0f && p.y >= 0.0f && p.z >= 0.0f);
+        QVERIFY(p.x <= 1.0f && p.y <= 1.0f && p.z <= 1.0f);
+    }
+    QVERIFY(reports.load() >= 4); // the scan is still held: these pixels came before the read
+    {
+        std::lock_guard lock(mutex);
+        release = true;
+    }
+    released.notify_all();
+    QVERIFY(waitForBuild(finished, failed).stats.complete);
+    QTRY_VERIFY(!service.busy());
+    service.setPrePassObserver({});
+}
+
 void TestBuilderService::cancelDuringTheBoundsPrePassKeepsThePreviousCloud() {
     QTemporaryDir dir;
     const QString path = dir.filePath(QStringLiteral("scan.ply"));

@@ -16,6 +16,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 
@@ -49,7 +50,15 @@ struct OpenOptions {
     // Called on the opening thread as the pre-pass advances (once per block, at its start and
     // at its end) with the bytes scanned and the file's size; it may set *cancel.
     std::function<void(std::uint64_t bytesScanned, std::uint64_t fileBytes)> onPrePassProgress;
+    // Called before each progress report (same thread) with the source positions the pre-pass
+    // sampled since the last one: an evenly strided sample of about kPrePassSamplePoints
+    // finite points over the file, so a viewer can draw the cloud in a provisional frame
+    // while its bounds are still being found (the first pixels of a large PLY or XYZ file).
+    std::function<void(std::span<const glm::dvec3> sourcePositions)> onPrePassPoints;
 };
+
+// About how many points the bounds pre-pass samples for OpenOptions::onPrePassPoints.
+inline constexpr std::uint64_t kPrePassSamplePoints = std::uint64_t{1} << 16;
 
 // What openPointCloud throws when OpenOptions::cancel stopped the bounds pre-pass: not an
 // input error, the file may be fine.

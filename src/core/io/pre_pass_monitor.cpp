@@ -4,6 +4,11 @@ namespace omicron {
 
 bool PrePassMonitor::report(std::uint64_t offset) {
     m_nextReport = offset + kReportBytes;
+    // Points first: a progress observer then sees every sample up to this offset.
+    if (m_options.onPrePassPoints && !m_sampled.empty()) {
+        m_options.onPrePassPoints(m_sampled);
+        m_sampled.clear();
+    }
     if (m_options.onPrePassProgress) {
         m_options.onPrePassProgress(offset, m_fileBytes);
     }

@@ -5,8 +5,10 @@
 
 #include "io/point_reader.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace omicron {
 
@@ -16,8 +18,19 @@ public:
     // the size of the readers' blocks, so a binary scan reports once per block.
     static constexpr std::uint64_t kReportBytes = std::uint64_t{1} << 20;
 
-    PrePassMonitor(const OpenOptions& options, std::string path, std::uint64_t fileBytes)
-        : m_options(options), m_path(std::move(path)), m_fileBytes(fileBytes) {}
+    // `estimatedPoints` (records, or lines of text) sets the stride of the point sample.
+    PrePassMonitor(const OpenOptions& options, std::string path, std::uint64_t fileBytes,
+                   std::uint64_t estimatedPoints)
+        : m_options(options), m_path(std::move(path)), m_fileBytes(fileBytes),
+          m_sampleStride(std::max<std::uint64_t>(1, estimatedPoints / kPrePassSamplePoints)) {}
+
+    // The point sample for OpenOptions::onPrePassPoints: record `index` (counting from 0) is
+    // sampled when this says so; its finite source position then goes to offer().
+    bool samples(std::uint64_t index) const {
+        return m_options.onPrePassPoints && index % m_sampleStride == 0;
+    }
+    std::uint64_t sampleStride() const { return m_sampleStride; }
+    void offer(const glm::dvec3& source) { m_sampled.push_back(source); }
 
     // The scan has read the file up to byte `offset`. Cheap between reports (one compare),
     // so text scans call it per line. False once cancelled: a block visitor returns it to stop
@@ -48,6 +61,8 @@ private:
     std::uint64_t m_nextReport = 0; // the first call reports: a scan starts visibly
     bool m_cancelled = false;
     std::uint64_t m_bytesScanned = 0;
+    std::uint64_t m_sampleStride;
+    std::vector<glm::dvec3> m_sampled; // since the last report
 };
 
 } // namespace omicron

@@ -179,6 +179,10 @@ void BuildPipeline::beginRun(BuildPhase phase) {
     m_bytesScanned.store(0);
     m_bytesToScan.store(0);
     m_sortRuns.store(0);
+    {
+        std::lock_guard lock(m_mutex);
+        m_provisional.clear();
+    }
     m_generation.fetch_add(1);
     setPhase(phase);
 }
@@ -224,6 +228,13 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
             m_prePassObserver(scanned, fileBytes);
         }
     };
+    openOptions.onPrePassPoints = [&](std::span<const glm::dvec3> sampled) {
+        std::lock_guard lock(m_mutex);
+        // The pre-pass samples about kPrePassSamplePoints; the cap only guards a bad estimate.
+        const std::size_t room = 4 * kPrePassSamplePoints - m_provisional.size();
+        m_provisional.insert(m_provisional.end(), sampled.begin(),
+                             sampled.begin() + std::min(room, sampled.size()));
+    };
     std::unique_ptr<PointReader> reader;
     try {
         reader = openPointCloud(path, openOptions);
@@ -257,6 +268,7 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
     {
         std::lock_guard lock(m_mutex);
         m_sorter = sorter;
+        m_provisional = {};
     }
     const auto builder = startBuilder(options.build);
     m_sourceReads.fetch_add(1);
@@ -455,11 +467,27 @@ PipelineProgress BuildPipeline::progress() const {
 
 PreviewSample BuildPipeline::preview() const {
     std::shared_ptr<const IncrementalMortonSorter> sorter;
+    PreviewSample provisional;
     {
         std::lock_guard lock(m_mutex);
         sorter = m_sorter;
+        if (!sorter && !m_provisional.empty()) {
+            // The bounds pre-pass's sample, framed by its own bounds so far: the final cube
+            // is not known yet, and the sorter's preview replaces this one once reading starts.
+            Bounds bounds;
+            for (const glm::dvec3& p : m_provisional) {
+                bounds.extend(p);
+            }
+            const CubeTransform frame = CubeTransform::fromBounds(bounds);
+            provisional.positions.reserve(m_provisional.size());
+            for (const glm::dvec3& p : m_provisional) {
+                provisional.positions.push_back(frame.toUnit(p));
+            }
+            provisional.pointsSeen = m_provisional.size();
+            provisional.provisional = true;
+        }
     }
-    return sorter ? sorter->preview() : PreviewSample{};
+    return sorter ? sorter->preview() : provisional;
 }
 
 std::optional<PipelineSource> BuildPipeline::source() const {

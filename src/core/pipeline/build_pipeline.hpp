@@ -28,6 +28,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace omicron {
 
@@ -160,7 +161,9 @@ public:
 
     // ---- Any thread. ----
     PipelineProgress progress() const;
-    // The sorter's random sample while pipeline 1 reads (empty otherwise).
+    // The sorter's random sample while pipeline 1 reads; before that, while a PLY or XYZ file
+    // is scanned for its bounds, a provisional one (PreviewSample::provisional: positions in
+    // the unit cube of the sample's own bounds so far); empty otherwise.
     PreviewSample preview() const;
     // Valid once the source is opened (cube, attributes, counts).
     std::optional<PipelineSource> source() const;
@@ -206,6 +209,7 @@ private:
     std::optional<PipelineSource> m_source;
     std::shared_ptr<const SortedCloud> m_cloud;
     std::shared_ptr<const IncrementalMortonSorter> m_sorter; // only while pipeline 1 reads
+    std::vector<glm::dvec3> m_provisional; // the bounds pre-pass's sample, source units
     std::shared_ptr<HierarchyBuilder> m_builder;
     // Pipeline 3: the loaded hierarchy and its statistics (from the file), without a builder.
     std::shared_ptr<const Hierarchy> m_loaded;

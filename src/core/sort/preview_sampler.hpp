@@ -16,6 +16,9 @@ struct PreviewSample {
     std::vector<glm::vec3> positions;
     std::vector<glm::u8vec3> colors; // empty when the cloud has no colour
     std::uint64_t pointsSeen = 0;
+    // Drawn from a bounds pre-pass before the final cube is known: positions are in a
+    // provisional unit cube (BuildPipeline::preview).
+    bool provisional = false;
 };
 
 class PreviewSampler {

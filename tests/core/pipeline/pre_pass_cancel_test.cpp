@@ -16,8 +16,10 @@
 #include <atomic>
 #include <cstring>
 #include <filesystem>
+#include <glm/gtx/component_wise.hpp>
 #include <gtest/gtest.h>
 #include <limits>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -105,6 +107,43 @@ TEST_P(PrePass, CancelStopsTheScanBeforeTheEndOfTheFile) {
     EXPECT_LT(reports.back(), fileBytes);
 }
 
+// The pre-pass's preview sample is the file's own points at a constant stride, in file order,
+// about kPrePassSamplePoints of them (all of a smaller file), delivered as the scan advances.
+TEST_P(PrePass, SamplesEveryStrideThPointForTheFirstPixels) {
+    test::TempDir dir;
+    const std::string path = writeCase(dir, GetParam());
+    std::vector<glm::dvec3> sampled;
+    std::size_t deliveries = 0;
+    OpenOptions options;
+    options.onPrePassPoints = [&](std::span<const glm::dvec3> points) {
+        sampled.insert(sampled.end(), points.begin(), points.end());
+        ++deliveries;
+    };
+    const LoadedCloud cloud = loadPointCloud(path, options);
+    const std::size_t n = cloud.points.size();
+    ASSERT_GT(sampled.size(), 1u);
+    EXPECT_GT(deliveries, 1u) << "delivered as the scan advances, not once at the end";
+    const double tolerance = 1e-5 * cloud.info.cube.edge;
+    const auto source = [&](std::size_t i) {
+        return cloud.info.cube.toSource(cloud.points.positions[i]);
+    };
+    const auto near = [&](const glm::dvec3& a, const glm::dvec3& b) {
+        return glm::all(glm::lessThanEqual(glm::abs(a - b), glm::dvec3(tolerance)));
+    };
+    std::size_t stride = 1;
+    while (stride < n && !near(sampled[1], source(stride))) {
+        ++stride;
+    }
+    ASSERT_LT(stride, n) << "the second sample is no point of the file";
+    EXPECT_EQ(sampled.size(), (n + stride - 1) / stride);
+    EXPECT_LE(sampled.size(), 2 * kPrePassSamplePoints);
+    std::size_t misplaced = 0;
+    for (std::size_t j = 0; j < sampled.size() && j * stride < n; ++j) {
+        misplaced += near(sampled[j], source(j * stride)) ? 0 : 1;
+    }
+    EXPECT_EQ(misplaced, 0u);
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Layouts, PrePass,
     testing::Values(PrePassCase{"PlyBinaryFloat", "scene.ply", PlyEncoding::BinaryLittleEndian},
@@ -119,6 +158,33 @@ PipelineOptions smallOptions() {
     options.build.maxLevel = 6;
     options.sortChunks = 8;
     return options;
+}
+
+// While the bounds are scanned, preview() is the scan's sample in a provisional unit cube.
+TEST(BuildPipelinePrePass, PreviewDuringThePrePassIsProvisional) {
+    test::TempDir dir;
+    const std::string path = writeCase(dir, {"PlyAscii", "scene.ply", PlyEncoding::Ascii});
+    BuildPipeline pipeline;
+    PreviewSample during;
+    std::size_t reports = 0;
+    pipeline.setPrePassObserver([&](std::uint64_t, std::uint64_t) {
+        if (++reports == 3) {
+            during = pipeline.preview();
+        }
+    });
+    ASSERT_TRUE(pipeline.run(path, smallOptions()).stats.complete);
+    EXPECT_TRUE(during.provisional);
+    ASSERT_FALSE(during.positions.empty());
+    EXPECT_EQ(during.pointsSeen, during.positions.size());
+    glm::vec3 low(1.0f), high(0.0f);
+    for (const glm::vec3& p : during.positions) {
+        low = glm::min(low, p);
+        high = glm::max(high, p);
+    }
+    EXPECT_GE(glm::compMin(low), 0.0f);
+    EXPECT_LE(glm::compMax(high), 1.0f);
+    EXPECT_FLOAT_EQ(glm::compMax(high - low), 1.0f) << "framed by the sample's own bounds";
+    EXPECT_TRUE(pipeline.preview().positions.empty()) << "nothing left after the run";
 }
 
 TEST(BuildPipelinePrePass, CancelDuringThePrePassKeepsThePreviousCloudAndHierarchy) {

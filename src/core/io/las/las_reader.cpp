@@ -108,11 +108,15 @@ private:
     // Only when the header's bounds are unusable (NaN, min > max): one pass over the records.
     Bounds boundsPrePass(const OpenOptions& options) {
         Bounds bounds;
-        PrePassMonitor monitor(options, m_stream.path(), m_stream.size());
+        PrePassMonitor monitor(options, m_stream.path(), m_stream.size(), m_header.pointCount);
         monitor.advance(m_header.pointDataOffset);
         forEachBlock([&](const std::uint8_t* records, std::uint64_t count, std::uint64_t first) {
             for (std::uint64_t i = 0; i < count; ++i) {
-                bounds.extend(sourcePosition(records + i * m_header.recordLength));
+                const glm::dvec3 source = sourcePosition(records + i * m_header.recordLength);
+                bounds.extend(source);
+                if (monitor.samples(first + i)) {
+                    monitor.offer(source);
+                }
             }
             return monitor.reached(m_header.recordOffset(first + count));
         });

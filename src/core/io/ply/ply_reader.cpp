@@ -15,6 +15,7 @@
 #include <bit>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 
 namespace omicron {
 
@@ -659,7 +660,7 @@ FloatRecordLayout PlyReader::floatLayout() const {
 void PlyReader::runBoundsPrePass(const OpenOptions& options) {
     Bounds bounds;
     std::uint64_t finite = 0;
-    PrePassMonitor monitor(options, m_stream.path(), m_stream.size());
+    PrePassMonitor monitor(options, m_stream.path(), m_stream.size(), m_info.pointCount);
     monitor.advance(m_vertexStart);
     if (fastLayout()) {
         // Min/max of the stored floats, offset added once at the end: double(x) + offset is
@@ -669,6 +670,22 @@ void PlyReader::runBoundsPrePass(const OpenOptions& options) {
         visitFixedBlocks(
             [&](const std::uint8_t* records, std::size_t count, std::uint64_t firstIndex) {
                 extendFloatBox(records, count, layout, box);
+                if (monitor.samples(0)) {
+                    const std::uint64_t stride = monitor.sampleStride();
+                    for (std::uint64_t i = (firstIndex + stride - 1) / stride * stride;
+                         i < firstIndex + count; i += stride) {
+                        const std::uint8_t* record = records + (i - firstIndex) * m_recordBytes;
+                        glm::dvec3 source;
+                        for (int axis = 0; axis < 3; ++axis) {
+                            float value;
+                            std::memcpy(&value, record + layout.position[axis], sizeof value);
+                            source[axis] = double(value) + m_header.offset[axis];
+                        }
+                        if (SourceNormalizer::isFinite(source)) {
+                            monitor.offer(source);
+                        }
+                    }
+                }
                 return monitor.reached(m_vertexStart + (firstIndex + count) * m_recordBytes);
             });
         finite = box.finite;
@@ -679,13 +696,17 @@ void PlyReader::runBoundsPrePass(const OpenOptions& options) {
             }
         }
     } else {
-        visitVertexValues([&](const double* values, std::uint64_t, std::uint64_t byteOrLine) {
+        visitVertexValues([&](const double* values, std::uint64_t index,
+                              std::uint64_t byteOrLine) {
             const glm::dvec3 source(values[m_fields.position[0]] + m_header.offset.x,
                                     values[m_fields.position[1]] + m_header.offset.y,
                                     values[m_fields.position[2]] + m_header.offset.z);
             if (SourceNormalizer::isFinite(source)) {
                 ++finite;
                 bounds.extend(source);
+                if (monitor.samples(index)) {
+                    monitor.offer(source);
+                }
             }
             // Ascii vertices are numbered by line: the bytes read so far stand for progress
             // (the line reader reads from this thread, a block at a time).

@@ -397,12 +397,20 @@ XyzScan scanFile(FileStream& stream, PrePassMonitor& monitor) {
     const ColumnLayout layout = layoutFor(scan.columns, false);
     const int colorColumn = scan.columns == 6 ? -1 : layout.color;
     scanRow(row, layout.intensity, colorColumn, scan, path, scan.dataLine);
+    // Record scan.records - 1 was just scanned; a non-finite one is never delivered.
+    const auto sample = [&] {
+        if (monitor.samples(scan.records - 1) && row.positionFinite()) {
+            monitor.offer(glm::dvec3(row.values[0], row.values[1], row.values[2]));
+        }
+    };
+    sample();
     std::string_view line;
     while (nextContentLine(lines, line)) {
         monitor.advance(lines.lineOffset());
         row.parse(line);
         checkRow(row, scan.columns, scan.dataLine, path, lines.lineNumber());
         scanRow(row, layout.intensity, colorColumn, scan, path, lines.lineNumber());
+        sample();
     }
     monitor.finish();
     return scan;
@@ -430,7 +438,8 @@ IntensityScale chooseIntensityScale(const XyzScan& scan, int column, const std::
 class XyzReader final : public PointReader {
 public:
     XyzReader(const std::string& path, const OpenOptions& options) : m_stream(path) {
-        PrePassMonitor monitor(options, path, m_stream.size());
+        // About 30 bytes a line, for the stride of the preview sample.
+        PrePassMonitor monitor(options, path, m_stream.size(), m_stream.size() / 30);
         const XyzScan scan = scanFile(m_stream, monitor);
         if (scan.bounds.empty()) {
             throw InputError(InputErrorKind::NoPoints, path, InputLocation::none(),
