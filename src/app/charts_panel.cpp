@@ -32,7 +32,8 @@ ChartsPanel::ChartsPanel(QWidget* parent) : QWidget(parent) {
     m_front = add(tr("Front size"), tr("nodes"), {tr("front nodes")});
     m_cpu = add(tr("CPU per frame"), tr("ms"), {tr("total"), tr("front evaluation")});
     m_fpsChart = add(tr("Frame rate"), tr("fps"), {tr("fps")});
-    m_memory = add(tr("Memory"), tr("MiB"), {tr("process resident"), tr("hierarchy + cloud")});
+    m_memory = add(tr("Memory"), tr("MiB"),
+                   {tr("process resident"), tr("hierarchy + cloud"), tr("budget")});
     m_inserted->setToolTip(m_inserted->toolTip() +
                            tr("\nThe ideal line is the straight line to the final point count: "
                               "insertion at a constant rate."));
@@ -77,6 +78,10 @@ void ChartsPanel::setProgress(const PipelineProgress& progress) {
 
 void ChartsPanel::setHierarchyBytes(std::size_t bytes) {
     m_hierarchyBytes = bytes;
+}
+
+void ChartsPanel::setMemoryBudget(std::uint64_t bytes) {
+    m_memoryBudgetBytes = bytes;
 }
 
 void ChartsPanel::setFrame(const FrameStats& stats) {
@@ -158,6 +163,12 @@ void ChartsPanel::sample() {
     }
     m_memory->append(0, now, static_cast<double>(residentBytes()) / 1048576.0);
     m_memory->append(1, now, static_cast<double>(m_hierarchyBytes) / 1048576.0);
+    if (m_memoryBudgetBytes > 0) {
+        m_memory->setLine(2, {QPointF(0.0, static_cast<double>(m_memoryBudgetBytes) / 1048576.0),
+                              QPointF(now, static_cast<double>(m_memoryBudgetBytes) / 1048576.0)});
+    } else if (m_memory->line(2)->count() > 0) {
+        m_memory->setLine(2, {});
+    }
 }
 
 } // namespace omicron

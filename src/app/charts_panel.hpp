@@ -3,7 +3,7 @@
 // constant-rate line, the insertion delays (the paper's front insertion delay, leaf published
 // -> first drawn, from the view's frames; and sorted -> inserted, from the build's progress),
 // the front size, CPU milliseconds per frame (front evaluation and total), frames per second,
-// and resident memory.
+// and resident memory against the memory budget.
 #pragma once
 
 #include "pipeline/build_pipeline.hpp"
@@ -34,6 +34,9 @@ public slots:
     void startBuild();
     void setProgress(const omicron::PipelineProgress& progress);
     void setHierarchyBytes(std::size_t bytes);
+    // The memory budget the build was started with, drawn as a line on the memory chart;
+    // 0 (automatic: half of physical memory) draws none, so the chart keeps its detail.
+    void setMemoryBudget(std::uint64_t bytes);
     // A frame of the view: CPU ms for the whole frame and the front, fps, front nodes, and
     // the leaves it drew first (their delays are gathered until the next sample).
     void setFrame(const omicron::FrameStats& stats);
@@ -61,6 +64,7 @@ private:
     PipelineProgress m_progress;
     bool m_building = false;
     std::size_t m_hierarchyBytes = 0;
+    std::uint64_t m_memoryBudgetBytes = 0;
     bool m_haveFrame = false;
     double m_frameMs = 0.0;
     double m_frontMs = 0.0;

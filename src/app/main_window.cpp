@@ -263,6 +263,7 @@ void MainWindow::connectService() {
         m_title = title;
         setWindowTitle(tr("%1 — omicron").arg(title));
         m_chartsPanel->startBuild();
+        m_chartsPanel->setMemoryBudget(m_buildPanel->pipelineOptions().memoryBudgetBytes);
         m_progressBar->setValue(0);
         m_progressBar->show();
     });

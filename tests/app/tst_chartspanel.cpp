@@ -18,6 +18,7 @@ private slots:
     void chartsTheLeafToDrawnDelayOfTheFrames();
     void exportsPngAndCsv();
     void exportErrorsNameTheFile();
+    void memoryChartDrawsTheBudgetWhenOneIsSet();
 };
 
 void TestChartsPanel::samplesProgressAndFrames() {
@@ -136,6 +137,23 @@ void TestChartsPanel::exportErrorsNameTheFile() {
     QVERIFY2(error.contains(bad), qPrintable(error));
     QVERIFY(!chart.exportPng(QStringLiteral("/nonexistent-folder/chart.png"), &error));
     QVERIFY2(error.contains(QStringLiteral("/nonexistent-folder/chart.png")), qPrintable(error));
+}
+
+void TestChartsPanel::memoryChartDrawsTheBudgetWhenOneIsSet() {
+    ChartsPanel panel;
+    TimeSeriesChart* memory = panel.chart(QStringLiteral("Memory"));
+    QVERIFY(memory != nullptr);
+    QCOMPARE(memory->lineCount(), 3);
+    panel.startBuild();
+    panel.setMemoryBudget(std::uint64_t{256} << 20);
+    QTRY_VERIFY(memory->line(0)->count() >= 2);
+    QCOMPARE(memory->line(2)->count(), 2);
+    QCOMPARE(memory->line(2)->at(0).y(), 256.0);
+    QCOMPARE(memory->line(2)->at(1).y(), 256.0);
+    QCOMPARE(memory->line(2)->at(1).x(), memory->line(0)->points().last().x());
+    // Automatic (half of physical memory): no line, the chart keeps its scale.
+    panel.setMemoryBudget(0);
+    QTRY_COMPARE(memory->line(2)->count(), 0);
 }
 
 QTEST_MAIN(TestChartsPanel)
