@@ -133,6 +133,14 @@ MemoryOptions memoryOptions(const ParsedArgs& parsed, const std::string& outputP
     return memory;
 }
 
+std::string lowerExtension(const std::string& path) {
+    std::string extension = std::filesystem::path(path).extension().string();
+    for (char& c : extension) {
+        c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+    }
+    return extension;
+}
+
 std::vector<OptionSpec> withOptions(std::vector<OptionSpec> specs,
                                     const std::vector<OptionSpec>& more) {
     specs.insert(specs.end(), more.begin(), more.end());

@@ -62,6 +62,9 @@ struct MemoryOptions {
 // /tmp. Throws UsageError naming the option.
 MemoryOptions memoryOptions(const ParsedArgs& parsed, const std::string& outputPath);
 
+// The extension of `path`, lower case, with its dot (".ply"); "" when it has none.
+std::string lowerExtension(const std::string& path);
+
 // `specs` followed by `more`.
 std::vector<OptionSpec> withOptions(std::vector<OptionSpec> specs,
                                     const std::vector<OptionSpec>& more);

@@ -19,13 +19,6 @@ namespace omicron::cli {
 
 namespace {
 
-std::string lowerExtension(const std::string& path) {
-    std::string extension = std::filesystem::path(path).extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return extension;
-}
-
 struct WholeCloud {
     PointBatch points;
     CubeTransform cube;

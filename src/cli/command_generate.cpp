@@ -19,14 +19,6 @@ constexpr std::uint64_t kDefaultPoints = 3'000'000;
 constexpr std::uint64_t kDefaultSeed = 1;
 constexpr std::uint64_t kMaxPoints = 1'000'000'000;
 
-std::string lowerExtension(const std::string& path) {
-    std::string extension = std::filesystem::path(path).extension().string();
-    for (char& c : extension) {
-        c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
-    }
-    return extension;
-}
-
 int runGenerate(const std::vector<std::string>& args) {
     const ParsedArgs parsed = parseArgs(args, {{"points", true}, {"seed", true}, {"ascii", false}});
     if (parsed.help) {

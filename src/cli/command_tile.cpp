@@ -24,14 +24,6 @@ namespace {
 
 constexpr std::uint64_t kMaxCopies = 1'000'000;
 
-std::string lowerExtension(const std::string& path) {
-    std::string extension = std::filesystem::path(path).extension().string();
-    for (char& c : extension) {
-        c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
-    }
-    return extension;
-}
-
 // Copy k of n sits at column k % columns, row k / columns of a near-square grid, shifted by
 // whole extents (plus the gap) in x and y, so copies never overlap and the result reads like
 // one large survey.

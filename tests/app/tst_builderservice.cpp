@@ -24,6 +24,16 @@ namespace {
 
 constexpr int kBuildTimeoutMs = 120'000;
 
+// An ascii PLY of 150,000 generated points, about 10 MB: ten blocks of bounds scanning.
+QString writeAsciiScan(const QTemporaryDir& dir) {
+    const QString path = dir.filePath(QStringLiteral("scan.ply"));
+    PlyWriteOptions ascii;
+    ascii.encoding = PlyEncoding::Ascii;
+    const GeneratedScene scene = generateScene(150'000, 3);
+    writePly(path.toStdString(), scene.points, scene.cube, ascii);
+    return path;
+}
+
 PipelineOptions testOptions(int depth = 6) {
     PipelineOptions options;
     options.build.maxLevel = depth;
@@ -278,11 +288,7 @@ void TestBuilderService::cancelMidBuildEndsTheRun() {
 // has arrived). (The sorter's preview follows while reading, when a poll falls in it.)
 void TestBuilderService::firstPixelsComeFromTheBoundsPrePass() {
     QTemporaryDir dir;
-    const QString path = dir.filePath(QStringLiteral("scan.ply"));
-    PlyWriteOptions ascii;
-    ascii.encoding = PlyEncoding::Ascii; // about 10 MB: ten blocks of scanning
-    const GeneratedScene scene = generateScene(150'000, 3);
-    writePly(path.toStdString(), scene.points, scene.cube, ascii);
+    const QString path = writeAsciiScan(dir);
 
     std::mutex mutex;
     std::condition_variable released;
@@ -321,11 +327,7 @@ void TestBuilderService::firstPixelsComeFromTheBoundsPrePass() {
 
 void TestBuilderService::cancelDuringTheBoundsPrePassKeepsThePreviousCloud() {
     QTemporaryDir dir;
-    const QString path = dir.filePath(QStringLiteral("scan.ply"));
-    PlyWriteOptions ascii;
-    ascii.encoding = PlyEncoding::Ascii; // about 10 MB: ten blocks of scanning
-    const GeneratedScene scene = generateScene(150'000, 3);
-    writePly(path.toStdString(), scene.points, scene.cube, ascii);
+    const QString path = writeAsciiScan(dir);
 
     std::mutex mutex;
     std::condition_variable pressed;

@@ -217,6 +217,24 @@ PipelineResult BuildPipeline::finishBuild(HierarchyBuilder& builder, PipelineRes
     return result;
 }
 
+PipelineResult BuildPipeline::sortIntoBuilder(IncrementalMortonSorter& sorter,
+                                              HierarchyBuilder& builder, PipelineResult result) {
+    if (!result.cancelled) {
+        setPhase(BuildPhase::Sorting);
+        const auto sortStart = Clock::now();
+        sorter.sortAndEmit(builder.consumer());
+        result.sortSeconds = secondsSince(sortStart);
+        result.sortRuns = sorter.runCount();
+    }
+    {
+        // The sorter's unsorted copy of the input (or its runs) is as large as the cloud:
+        // let it go.
+        std::lock_guard lock(m_mutex);
+        m_sorter.reset();
+    }
+    return finishBuild(builder, std::move(result));
+}
+
 PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOptions& options) {
     beginRun(BuildPhase::Opening);
     OpenOptions openOptions;
@@ -287,19 +305,7 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
     result.readSeconds = secondsSince(readStart);
     result.skippedNonFinite = read.skippedNonFinite;
     result.cancelled = read.cancelled;
-    if (!result.cancelled) {
-        setPhase(BuildPhase::Sorting);
-        const auto sortStart = Clock::now();
-        sorter->sortAndEmit(builder->consumer());
-        result.sortSeconds = secondsSince(sortStart);
-        result.sortRuns = sorter->runCount();
-    }
-    {
-        // The sorter's unsorted copy of the input is as large as the cloud: let it go.
-        std::lock_guard lock(m_mutex);
-        m_sorter.reset();
-    }
-    return finishBuild(*builder, std::move(result));
+    return sortIntoBuilder(*sorter, *builder, std::move(result));
 }
 
 PipelineResult BuildPipeline::runSortedStream(const std::string& path,
@@ -390,18 +396,8 @@ PipelineResult BuildPipeline::runGeneratedScene(std::uint64_t points, std::uint6
         m_sortRuns.store(sorter->runCount(), std::memory_order_relaxed);
     }
     result.readSeconds = secondsSince(readStart);
-    if (!cancelled()) {
-        setPhase(BuildPhase::Sorting);
-        const auto sortStart = Clock::now();
-        sorter->sortAndEmit(builder->consumer());
-        result.sortSeconds = secondsSince(sortStart);
-        result.sortRuns = sorter->runCount();
-    }
-    {
-        std::lock_guard lock(m_mutex);
-        m_sorter.reset();
-    }
-    return finishBuild(*builder, std::move(result));
+    result.cancelled = cancelled();
+    return sortIntoBuilder(*sorter, *builder, std::move(result));
 }
 
 PipelineResult BuildPipeline::rebuild(const BuildOptions& options) {

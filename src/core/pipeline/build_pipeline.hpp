@@ -190,6 +190,10 @@ private:
     void setSource(const PipelineSource& source, std::shared_ptr<const SortedCloud> cloud);
     std::shared_ptr<HierarchyBuilder> startBuilder(const BuildOptions& options);
     PipelineResult finishBuild(HierarchyBuilder& builder, PipelineResult result);
+    // After the read: the sort's ranges into the builder (unless result.cancelled), then
+    // finishBuild.
+    PipelineResult sortIntoBuilder(IncrementalMortonSorter& sorter, HierarchyBuilder& builder,
+                                   PipelineResult result);
     void setPhase(BuildPhase phase) { m_phase.store(static_cast<int>(phase)); }
     bool cancelled() const { return m_cancel.load(std::memory_order_relaxed); }
 

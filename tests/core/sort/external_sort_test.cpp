@@ -88,6 +88,14 @@ std::string writeAdversarialCloud(const test::TempDir& dir, std::size_t count) {
     return path;
 }
 
+// The smallest budget: every cloud here spills, into `scratch`.
+SortOptions spillingOptions(const test::TempDir& scratch) {
+    SortOptions options;
+    options.memoryBudgetBytes = kMinMemoryBudget;
+    options.tempDir = scratch.path().string();
+    return options;
+}
+
 class ExternalSort : public testing::TestWithParam<std::string> {};
 
 TEST_P(ExternalSort, RunsOnDiskGiveThePointsOfTheInMemorySort) {
@@ -95,9 +103,7 @@ TEST_P(ExternalSort, RunsOnDiskGiveThePointsOfTheInMemorySort) {
     test::TempDir scratch;
     const Sorted inMemory = sortFile(path, SortOptions{});
     ASSERT_FALSE(inMemory.spilled);
-    SortOptions spilling;
-    spilling.memoryBudgetBytes = kMinMemoryBudget;
-    spilling.tempDir = scratch.path().string();
+    const SortOptions spilling = spillingOptions(scratch);
     const Sorted external = sortFile(path, spilling);
     EXPECT_TRUE(external.spilled);
     EXPECT_TRUE(external.complete);
@@ -113,9 +119,7 @@ TEST(ExternalSortAdversarial, EqualCodesAcrossRunsKeepTheirInputOrder) {
     test::TempDir dir;
     test::TempDir scratch;
     const std::string path = writeAdversarialCloud(dir, 300'000);
-    SortOptions spilling;
-    spilling.memoryBudgetBytes = kMinMemoryBudget;
-    spilling.tempDir = scratch.path().string();
+    const SortOptions spilling = spillingOptions(scratch);
     std::size_t runs = 0;
     {
         auto reader = openPointCloud(path);
@@ -151,9 +155,7 @@ TEST(ExternalSortAdversarial, BatchesWithoutTheCloudAreTheSameStream) {
     test::TempDir dir;
     test::TempDir scratch;
     const std::string path = writeAdversarialCloud(dir, 200'000);
-    SortOptions spilling;
-    spilling.memoryBudgetBytes = kMinMemoryBudget;
-    spilling.tempDir = scratch.path().string();
+    const SortOptions spilling = spillingOptions(scratch);
     auto reader = openPointCloud(path);
     IncrementalMortonSorter sorter(reader->info(), spilling);
     reader->read([&](const PointBatch& batch) { sorter.add(batch); });
@@ -211,9 +213,7 @@ TEST(ExternalSortCleanup, AReaderFailureMidwayRemovesTheRuns) {
     test::TempDir dir;
     test::TempDir scratch;
     const LoadedCloud cloud = loadPointCloud(writeAdversarialCloud(dir, 200'000));
-    SortOptions spilling;
-    spilling.memoryBudgetBytes = kMinMemoryBudget;
-    spilling.tempDir = scratch.path().string();
+    const SortOptions spilling = spillingOptions(scratch);
     const IncrementalMortonSorter* sorter = nullptr;
     std::size_t runsWhenFailing = 0;
     std::size_t entriesWhenFailing = 0;
@@ -235,9 +235,7 @@ TEST(ExternalSortCleanup, ACancelDuringTheMergeStopsAndRemovesTheRuns) {
     test::TempDir scratch;
     const std::string path = writeAdversarialCloud(dir, 200'000);
     std::atomic<bool> cancel{false};
-    SortOptions spilling;
-    spilling.memoryBudgetBytes = kMinMemoryBudget;
-    spilling.tempDir = scratch.path().string();
+    SortOptions spilling = spillingOptions(scratch);
     spilling.cancel = &cancel;
     auto reader = openPointCloud(path);
     std::size_t ranges = 0;
@@ -257,9 +255,7 @@ TEST(ExternalSortCleanup, AFullDiskIsAClearErrorAndLeavesNothing) {
     test::TempDir dir;
     test::TempDir scratch;
     const std::string path = writeAdversarialCloud(dir, 300'000);
-    SortOptions spilling;
-    spilling.memoryBudgetBytes = kMinMemoryBudget;
-    spilling.tempDir = scratch.path().string();
+    const SortOptions spilling = spillingOptions(scratch);
     auto reader = openPointCloud(path);
     const std::uint64_t needed =
         reader->info().pointCount * PointRecordLayout::of(reader->info().attributes).bytes;
