@@ -17,6 +17,7 @@
 #pragma once
 
 #include "build/chunked_arena.hpp"
+#include "build/node_residency.hpp"
 #include "build/octree_node.hpp"
 #include "build/sample_store.hpp"
 #include "build/splat_estimator.hpp"
@@ -96,6 +97,15 @@ public:
     // sample its covered range.
     SparseSplatRegion sparseSplatRegion(const OctreeNode& node) const;
 
+    // Which nodes' points are in memory when they are paged in on demand (a large .omh);
+    // nullptr when every published node's points are (node_residency.hpp). A service the
+    // render front talks to, so non-const through a const hierarchy.
+    NodeResidency* residency() const { return m_residency.get(); }
+    // True when node `index` of `level` (published) may have its points read now.
+    bool pointsResident(int level, std::size_t index) const {
+        return !m_residency || m_residency->resident(level, static_cast<std::uint32_t>(index));
+    }
+
     // Index of the node with `code` among the first `count` nodes of its level (Morton order).
     std::optional<std::size_t> findNode(morton::Code code, std::size_t count) const;
 
@@ -141,6 +151,11 @@ public:
         return m_samples.adopt(std::move(samples));
     }
     StoredSplats& mutableStoredSplats() { return *m_storedSplats; } // SplatSource::Stored only
+    // Set once, before the hierarchy is shared. The hierarchy owns it and destroys it first,
+    // so its loading threads stop before the cloud and splats they write go away.
+    void setResidency(std::unique_ptr<NodeResidency> residency) {
+        m_residency = std::move(residency);
+    }
 
     void publishNodes(int level);
     // Appends `count` unwritten entries to the insertion log (span order), assigned through
@@ -183,6 +198,8 @@ private:
     std::atomic<morton::Code> m_cutDelimiter{0};
     std::atomic<std::uint64_t> m_epoch{0};
     std::atomic<bool> m_complete{false};
+    // Last: destroyed first (see setResidency).
+    std::unique_ptr<NodeResidency> m_residency;
 };
 
 } // namespace omicron

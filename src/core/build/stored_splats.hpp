@@ -13,23 +13,24 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <span>
 
 namespace omicron {
 
 class StoredSplats {
 public:
-    // Allocates the per-point arrays for the cloud's full capacity.
+    // Allocates the per-point arrays for the cloud's full capacity (small pages for a cloud
+    // paged in on demand, so a node's attributes are released with its points).
     explicit StoredSplats(const SortedCloud& cloud)
         : m_capacity(cloud.capacity()),
-          m_radii(std::make_unique_for_overwrite<std::uint16_t[]>(m_capacity)),
-          m_normals(cloud.attributes().has(Attribute::Normal)
-                        ? nullptr
-                        : std::make_unique_for_overwrite<std::uint32_t[]>(m_capacity)) {}
+          m_radii(m_capacity, cloud.pagedOnDemand() ? PageSize::Small : PageSize::Huge),
+          m_normals(cloud.attributes().has(Attribute::Normal) ? 0 : m_capacity,
+                    cloud.pagedOnDemand() ? PageSize::Small : PageSize::Huge) {}
 
     StoredSplats(const StoredSplats&) = delete;
     StoredSplats& operator=(const StoredSplats&) = delete;
 
-    bool estimatesNormals() const { return m_normals != nullptr; }
+    bool estimatesNormals() const { return m_normals.size() != 0; }
     // Valid for points of published levels.
     std::uint16_t encodedRadius(std::size_t point) const { return m_radii[point]; }
     // Only when estimatesNormals().
@@ -39,20 +40,23 @@ public:
     // when the cloud has normals of its own).
     void setEncoded(std::size_t point, std::uint16_t encodedRadius, std::uint32_t encodedNormal) {
         m_radii[point] = encodedRadius;
-        if (m_normals) {
+        if (estimatesNormals()) {
             m_normals[point] = encodedNormal;
         }
     }
+    // The arrays themselves, for a pager that gives their pages back (resident_pages.hpp).
+    std::span<std::uint16_t> mutableRadii() { return m_radii; }
+    std::span<std::uint32_t> mutableNormals() { return m_normals; }
 
     std::size_t bytesResident() const {
-        return m_capacity * (sizeof(std::uint16_t) + (m_normals ? sizeof(std::uint32_t) : 0));
+        return m_capacity * (sizeof(std::uint16_t) + (estimatesNormals() ? sizeof(std::uint32_t) : 0));
     }
 
 private:
     std::size_t m_capacity;
     // Left uninitialised: the loader writes every point of a level before publishing it.
-    std::unique_ptr<std::uint16_t[]> m_radii;
-    std::unique_ptr<std::uint32_t[]> m_normals; // null when the cloud has normals
+    HugePageArray<std::uint16_t> m_radii;
+    HugePageArray<std::uint32_t> m_normals; // empty when the cloud has normals
 };
 
 } // namespace omicron

@@ -1,5 +1,7 @@
 #include "formats/omh_reader.hpp"
 
+#include "formats/omh_pager.hpp"
+#include "formats/omh_record_decoder.hpp"
 #include "io/input_error.hpp"
 
 #include <algorithm>
@@ -356,10 +358,26 @@ void OmhReader::createHierarchy() {
         }
         m_cloud = std::make_shared<SortedCloud>(
             m_header.cube, m_header.sourceOffset, m_header.attributes,
-            static_cast<std::size_t>(m_header.totalPoints), CloudOrder::NodeOrder);
+            static_cast<std::size_t>(m_header.totalPoints), CloudOrder::NodeOrder,
+            PointStorage::Exact, pagedOnDemand() ? PageSize::Small : PageSize::Huge);
         m_hierarchy =
             std::make_shared<Hierarchy>(m_cloud, m_header.build.maxLevel, SplatSource::Stored);
+        if (pagedOnDemand()) {
+            m_hierarchy->setResidency(
+                std::make_unique<OmhPager>(m_header, m_cloud, *m_hierarchy, m_pagedBudget));
+        }
     });
+}
+
+void OmhReader::pageOnDemand(std::uint64_t budgetBytes) {
+    if (m_hierarchy) {
+        throw std::logic_error(m_header.path + ": OmhReader::pageOnDemand() after hierarchy()");
+    }
+    m_pagedBudget = std::max<std::uint64_t>(budgetBytes, 1);
+}
+
+std::uint64_t OmhReader::residentBytesOfAllPoints() const {
+    return m_header.totalPoints * OmhPager::residentBytesPerPoint(m_header);
 }
 
 std::shared_ptr<const Hierarchy> OmhReader::hierarchy() {
@@ -476,16 +494,13 @@ void OmhReader::readPoints(int level, const std::vector<OctreeNode>& nodes,
     const std::string section = omhSectionAt(m_header, entry.payloadOffset);
     const std::size_t recordBytes = m_layout.bytes;
     const std::size_t blockRecords = std::max<std::size_t>(1, kBlockBytes / recordBytes);
-    SortedCloud& cloud = *m_cloud;
-    StoredSplats& splats = m_hierarchy->mutableStoredSplats();
-    const AttributeSet attributes = m_header.attributes;
-    const int shift = 3 * (morton::kMaxLevel - level);
+    const OmhRecordDecoder decoder(m_header, *m_cloud, m_hierarchy->mutableStoredSplats());
     oms::PayloadChecksum checksum;
     // A point that breaks a rule is reported only after the checksum matched: in a damaged
     // file the checksum mismatch is the better explanation.
     std::optional<InputError> firstProblem;
     std::size_t nodeIndex = 0;
-    std::uint64_t nodeEnd = nodes.empty() ? 0 : nodes[0].pointCount;
+    std::uint64_t nodeBegin = 0; // the current node's first record in the level
     m_stream.seek(entry.payloadOffset);
     for (std::uint64_t begin = 0; begin < entry.points;) {
         const std::size_t count =
@@ -493,41 +508,26 @@ void OmhReader::readPoints(int level, const std::vector<OctreeNode>& nodes,
         m_block.resize(count * recordBytes);
         m_stream.readExact(m_block.data(), m_block.size(), section);
         checksum.update(m_block.data(), m_block.size());
-        const std::uint8_t* record = m_block.data();
-        for (std::size_t r = 0; r < count; ++r, record += recordBytes) {
-            const std::uint64_t inLevel = begin + r;
-            while (inLevel >= nodeEnd) {
-                nodeEnd += nodes[++nodeIndex].pointCount;
+        // The block's records node by node.
+        for (std::size_t r = 0; r < count;) {
+            while (begin + r >= nodeBegin + nodes[nodeIndex].pointCount) {
+                nodeBegin += nodes[nodeIndex++].pointCount;
             }
-            const std::size_t point = static_cast<std::size_t>(firstPoint + inLevel);
-            const auto p = loadLe<glm::vec3>(record);
-            const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-            const morton::Code code = finite ? morton::encodeUnit(p.x, p.y, p.z) : 0;
-            if ((!finite || (code >> shift) != nodes[nodeIndex].code) && !firstProblem) {
+            const OctreeNode& node = nodes[nodeIndex];
+            const std::size_t run = static_cast<std::size_t>(
+                std::min<std::uint64_t>(count - r, nodeBegin + node.pointCount - (begin + r)));
+            const std::uint64_t inLevel = begin + r;
+            const std::size_t bad =
+                decoder.store(m_block.data() + r * recordBytes, run,
+                              static_cast<std::size_t>(firstPoint + inLevel), node.code, level);
+            if (bad != run && !firstProblem) {
                 firstProblem.emplace(
                     InputErrorKind::MalformedValue, m_header.path,
-                    InputLocation::byte(entry.payloadOffset + inLevel * recordBytes),
-                    "in " + section + ", record " + std::to_string(inLevel) +
-                        ": the position lies outside the cell of its node " +
-                        hex(nodes[nodeIndex].code));
+                    InputLocation::byte(entry.payloadOffset + (inLevel + bad) * recordBytes),
+                    "in " + section + ", record " + std::to_string(inLevel + bad) +
+                        ": the position lies outside the cell of its node " + hex(node.code));
             }
-            cloud.mutablePositions()[point] = p;
-            if (attributes.has(Attribute::Normal)) {
-                cloud.mutableNormals()[point] =
-                    loadLe<glm::vec3>(record + m_layout.point.normalOffset);
-            }
-            if (attributes.has(Attribute::Color)) {
-                cloud.mutableColors()[point] =
-                    loadLe<glm::u8vec3>(record + m_layout.point.colorOffset);
-            }
-            if (attributes.has(Attribute::Intensity)) {
-                cloud.mutableIntensities()[point] =
-                    loadLe<std::uint16_t>(record + m_layout.point.intensityOffset);
-            }
-            splats.setEncoded(point, loadLe<std::uint16_t>(record + m_layout.radiusOffset),
-                              m_header.estimatedNormals
-                                  ? loadLe<std::uint32_t>(record + m_layout.estimatedNormalOffset)
-                                  : 0u);
+            r += run;
         }
         begin += count;
     }
@@ -561,12 +561,17 @@ void OmhReader::load(const LevelCallback& onLevel, const std::atomic<bool>* canc
         }
         const std::vector<OctreeNode> nodes =
             readNodes(level, childMasks, expectedCodes, firstPoint);
-        readPoints(level, nodes, firstPoint);
+        if (!pagedOnDemand()) {
+            readPoints(level, nodes, firstPoint);
+        }
         for (const OctreeNode& node : nodes) {
             m_hierarchy->appendNode(level, node);
         }
         firstPoint += m_header.levels[static_cast<std::size_t>(level)].points;
-        m_cloud->publish(static_cast<std::size_t>(firstPoint));
+        if (!pagedOnDemand()) {
+            // A paged cloud is never published as a prefix: the pager says what is resident.
+            m_cloud->publish(static_cast<std::size_t>(firstPoint));
+        }
         m_hierarchy->publishNodes(level);
         if (onLevel) {
             onLevel(level);
@@ -578,7 +583,9 @@ void OmhReader::load(const LevelCallback& onLevel, const std::atomic<bool>* canc
                          "in the node table of the deepest level: nodes announce children below "
                          "the hierarchy's depth");
     }
-    m_cloud->markComplete();
+    if (!pagedOnDemand()) {
+        m_cloud->markComplete();
+    }
 }
 
 void OmhReader::verify() {

@@ -46,9 +46,17 @@ public:
     // 32 bits).
     std::shared_ptr<const Hierarchy> hierarchy();
 
+    // Loads nodes only and pages their points in on demand under `budgetBytes`
+    // (formats/omh_pager.hpp): for a file whose points do not fit in memory. Call before
+    // hierarchy() and load(). Throws InputError when the file cannot be opened again.
+    void pageOnDemand(std::uint64_t budgetBytes);
+    bool pagedOnDemand() const { return m_pagedBudget > 0; }
+    // Bytes the points of the whole file take in memory once loaded (what paging avoids).
+    std::uint64_t residentBytesOfAllPoints() const;
+
     using LevelCallback = std::function<void(int level)>;
 
-    // Loads every level, top-down, on the calling thread (a renderer may read hierarchy()
+    // Loads every level, top-down, on the calling thread (paged: the node records only) (a renderer may read hierarchy()
     // meanwhile). Each section's checksum is verified before anything of it is published.
     // `cancel` is checked between levels. Call at most once. Throws InputError naming the
     // section: MalformedValue (checksum mismatch, a node or point that breaks the format's
@@ -74,6 +82,7 @@ private:
     std::shared_ptr<Hierarchy> m_hierarchy;
     std::vector<std::uint8_t> m_block;
     bool m_loadCalled = false;
+    std::uint64_t m_pagedBudget = 0; // > 0: points paged in on demand
 };
 
 // "the node table of level 3 (bytes 1024-2047)" etc.: the section holding byte `offset`.

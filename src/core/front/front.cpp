@@ -6,6 +6,7 @@
 #include <cassert>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 
 namespace omicron {
 
@@ -50,7 +51,7 @@ std::optional<std::size_t> ParentCursor::find(const Hierarchy& hierarchy, morton
 }
 
 Front::Impl::Impl(std::shared_ptr<const Hierarchy> sharedHierarchy)
-    : shared(std::move(sharedHierarchy)), hierarchy(*shared),
+    : shared(std::move(sharedHierarchy)), hierarchy(*shared), residency(shared->residency()),
       substitution(shared->maxLevel()) {}
 
 void Front::Impl::loadPublished() {
@@ -65,7 +66,8 @@ void Front::Impl::takeInsertions(FrontEvaluation& result) {
     // loaded top-down) is entered from its root; a loader publishes the root after marking
     // the hierarchy complete, so wait for it.
     if (mode != Mode::TopDown && insertionsTaken == 0 && cut.complete) {
-        if (nodeCounts[0] > 0) {
+        // Paged points: the root enters once it can be drawn.
+        if (nodeCounts[0] > 0 && wantResident(0, 0, std::numeric_limits<double>::max())) {
             mode = Mode::TopDown;
             entries.assign(1, FrontEntry{morton::kRoot, 0, false, false});
             levelCounts.fill(0);
@@ -121,6 +123,27 @@ bool Front::Impl::childrenReady(const OctreeNode& node, int level) const {
     return settled(hierarchy.node(level + 1, node.firstChild).code);
 }
 
+bool Front::Impl::childrenResident(const OctreeNode& node, int level, double priority) {
+    bool all = true;
+    for (std::uint32_t child = 0; child < node.childCount; ++child) {
+        // Ask for every missing child at once: they load while the parent stays drawn.
+        all = wantResident(level + 1, std::size_t{node.firstChild} + child, priority) && all;
+    }
+    return all;
+}
+
+void Front::Impl::holdEntries() {
+    if (residency == nullptr) {
+        return;
+    }
+    for (const FrontEntry& entry : entries) {
+        if (!entry.placeholder) {
+            residency->hold(entry.level(), entry.index);
+        }
+    }
+    residency->endFrame();
+}
+
 // One segment of the sweep, from sweepPosition until the end or the CPU budget; true when it
 // reached the end. Works in place: each entry read yields at most one entry written.
 bool Front::Impl::sweep(const FrontOptions& options, FrontEvaluation& result) {
@@ -173,9 +196,12 @@ bool Front::Impl::sweep(const FrontOptions& options, FrontEvaluation& result) {
                     const CellBox box = cellBox(parentCode);
                     FrontEntry parent{parentCode, static_cast<std::uint32_t>(*parentIndex), false,
                                       intersectsFrustum(frustum, box)};
+                    const double parentSizePx = projectedSizePx(box, camera);
                     // Out of view, a group only makes the front longer: prune it whatever
-                    // its size.
-                    if (!parent.visible || projectedSizePx(box, camera) < thresholdPx) {
+                    // its size (paged points: once the parent is in memory; out of view it
+                    // loads after what is seen).
+                    if ((!parent.visible || parentSizePx < thresholdPx) &&
+                        wantResident(level - 1, *parentIndex, parent.visible ? parentSizePx : 0.0)) {
                         for (std::size_t member = read; member < end; ++member) {
                             account(entries[member], -1);
                         }
@@ -200,7 +226,7 @@ bool Front::Impl::sweep(const FrontOptions& options, FrontEvaluation& result) {
             const OctreeNode& node = hierarchy.node(level, entry.index);
             if (childrenReady(node, level)) {
                 const double sizePx = projectedSizePx(box, camera);
-                if (sizePx > thresholdPx) {
+                if (sizePx > thresholdPx && childrenResident(node, level, sizePx)) {
                     candidates.push_back({written - 1, sizePx});
                 }
             }
@@ -241,6 +267,7 @@ FrontEvaluation Front::evaluate(const FrontCamera& camera, const FrontOptions& o
     result.finishedSweep = state.sweep(options, result);
     state.sweepRunning = !result.finishedSweep;
     state.applyBudget(options, result);
+    state.holdEntries();
 
     result.substitutionLevel = state.substitutionLevel;
     result.visibleNodes = state.visibleNodes;

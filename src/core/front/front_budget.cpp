@@ -50,14 +50,18 @@ void Front::Impl::collectPrunableGroups(double parentSizeBelowPx) {
             const auto parentIndex = parents.find(hierarchy, parentCode, nodeCounts[parentLevel]);
             if (parentIndex) {
                 const OctreeNode& parent = hierarchy.node(parentLevel, *parentIndex);
-                if (parent.childCount == end - i) {
+                const CellBox box = cellBox(parentCode);
+                const double parentSizePx = projectedSizePx(box, camera);
+                // Paged points: a parent not in memory cannot replace its children yet.
+                if (parent.childCount == end - i &&
+                    (parentSizePx >= parentSizeBelowPx ||
+                     wantResident(parentLevel, *parentIndex, parentSizePx))) {
                     PrunableGroup group;
                     group.position = i;
                     group.members = static_cast<std::uint32_t>(end - i);
                     group.parentIndex = static_cast<std::uint32_t>(*parentIndex);
-                    const CellBox box = cellBox(parentCode);
                     group.parentVisible = intersectsFrustum(frustum, box);
-                    group.parentSizePx = projectedSizePx(box, camera);
+                    group.parentSizePx = parentSizePx;
                     for (std::size_t member = i; member < end; ++member) {
                         const FrontEntry& entry = entries[member];
                         if (entry.visible) {

@@ -68,7 +68,17 @@ struct Front::Impl {
     void startSweep(FrontEvaluation& result);
     bool sweep(const FrontOptions& options, FrontEvaluation& result);
     FrontEntry evaluateNode(FrontEntry entry, const OctreeNode& node);
+    // The node's children are published and settled, so it may branch once they are resident.
     bool childrenReady(const OctreeNode& node, int level) const;
+    // Paged points (hierarchy.residency()): asks for the node and says whether it is resident
+    // now; always true when every node's points are in memory.
+    bool wantResident(int level, std::size_t index, double priority) {
+        return residency == nullptr ||
+               residency->want(level, static_cast<std::uint32_t>(index), priority);
+    }
+    bool childrenResident(const OctreeNode& node, int level, double priority);
+    // Paged points: the entries are held for this frame, the rest may be evicted.
+    void holdEntries();
     bool settled(morton::Code code) const {
         return Hierarchy::isSettled(code, cut, hierarchy.maxLevel());
     }
@@ -83,6 +93,7 @@ struct Front::Impl {
 
     std::shared_ptr<const Hierarchy> shared;
     const Hierarchy& hierarchy;
+    NodeResidency* residency; // hierarchy.residency(): null unless points are paged
     Mode mode = Mode::Undecided;
 
     // The front, in span order. Between calls it is contiguous; during a sweep the entries

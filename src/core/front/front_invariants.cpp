@@ -72,6 +72,10 @@ std::string Front::checkInvariants() const {
             if (!Hierarchy::isSettled(entry.code, state.cut, maxLevel)) {
                 return "2.2: " + describe(entry, i) + " is a root of the cut or a child of one";
             }
+            // Paged points: the front holds only nodes that can be drawn.
+            if (!hierarchy.pointsResident(level, entry.index)) {
+                return describe(entry, i) + ": its points are not in memory";
+            }
             const OctreeNode& node = hierarchy.node(level, entry.index);
             coveredBegin = node.coveredBegin;
             coveredCount = node.coveredCount;

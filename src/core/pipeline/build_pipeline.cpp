@@ -2,6 +2,7 @@
 
 #include "formats/omh_reader.hpp"
 #include "formats/oms_reader.hpp"
+#include "memory_budget.hpp"
 #include "scene/scene_generator.hpp"
 
 #include <algorithm>
@@ -96,7 +97,7 @@ PipelineResult BuildPipeline::run(const std::string& path, const PipelineOptions
     }
     try {
         if (isOmhFile(path)) {
-            return runHierarchyFile(path);
+            return runHierarchyFile(path, options);
         }
         return isOmsFile(path) ? runSortedStream(path, options) : runCloud(path, options);
     } catch (...) {
@@ -115,11 +116,19 @@ PipelineResult BuildPipeline::run(const std::string& path, const PipelineOptions
     }
 }
 
-PipelineResult BuildPipeline::runHierarchyFile(const std::string& path) {
+PipelineResult BuildPipeline::runHierarchyFile(const std::string& path,
+                                               const PipelineOptions& options) {
     beginRun(BuildPhase::Opening);
     const auto start = Clock::now();
     OmhReader reader(path); // header, level table and footer checked: throws before any change
     const omh::Header& header = reader.header();
+    // Points beyond the budget are paged in as the view asks for them; otherwise the whole
+    // file loads top-down, as it always did.
+    const std::uint64_t budget =
+        options.memoryBudgetBytes > 0 ? options.memoryBudgetBytes : defaultMemoryBudget();
+    if (reader.residentBytesOfAllPoints() > budget) {
+        reader.pageOnDemand(budget);
+    }
     PipelineSource source;
     source.path = path;
     source.kind = PipelineKind::HierarchyFile;
@@ -161,6 +170,10 @@ PipelineResult BuildPipeline::runHierarchyFile(const std::string& path) {
     PipelineResult result;
     result.source = source;
     result.pipeline = toString(PipelineKind::HierarchyFile);
+    if (reader.pagedOnDemand()) {
+        result.pipeline += ", points paged in on demand";
+    }
+    result.pagedPoints = reader.pagedOnDemand();
     result.readSeconds = secondsSince(start);
     result.cancelled = cancelled();
     statistics.complete = !result.cancelled;

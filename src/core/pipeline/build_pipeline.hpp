@@ -97,6 +97,9 @@ struct PipelineResult {
     double readSeconds = 0.0; // streaming the points (and, for .oms, the sorted ranges)
     double sortSeconds = 0.0; // sorter emission after the read; 0 for .oms and rebuild
     std::size_t sortRuns = 0; // runs spilled to disk and merged (0: sorted in memory)
+    // A .omh larger than the memory budget: its nodes were loaded, their points are paged in
+    // as a front asks for them (hierarchy()->residency()).
+    bool pagedPoints = false;
     std::uint64_t skippedNonFinite = 0;
     bool cancelled = false;
     std::string pipeline; // human-readable, e.g. "unsorted cloud -> incremental sorter -> builder"
@@ -111,7 +114,8 @@ struct PipelineOptions {
     // What the sort may keep resident (0: defaultMemoryBudget()); beyond it, pipeline 1 sorts
     // in runs on disk under `tempDir` (empty: $TMPDIR or /tmp) and merges them into the cloud.
     // The sorted cloud itself stays resident for the builder (15 bytes a point exact, about 7
-    // packed).
+    // packed). A .omh whose points exceed it opens with its points paged in on demand, the
+    // least recently used evicted to stay within it (formats/omh_pager.hpp).
     std::uint64_t memoryBudgetBytes = 0;
     std::string tempDir = {};
 };
@@ -185,7 +189,7 @@ public:
 private:
     PipelineResult runCloud(const std::string& path, const PipelineOptions& options);
     PipelineResult runSortedStream(const std::string& path, const PipelineOptions& options);
-    PipelineResult runHierarchyFile(const std::string& path);
+    PipelineResult runHierarchyFile(const std::string& path, const PipelineOptions& options);
     void beginRun(BuildPhase phase);
     void setSource(const PipelineSource& source, std::shared_ptr<const SortedCloud> cloud);
     std::shared_ptr<HierarchyBuilder> startBuilder(const BuildOptions& options);

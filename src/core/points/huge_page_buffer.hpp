@@ -6,9 +6,15 @@
 // advised MADV_HUGEPAGE takes one fault and one TLB entry per 2 MiB instead. Where huge
 // pages are off ("never") this is an ordinary aligned allocation. The elements are left
 // uninitialised: the owners write before they publish.
+//
+// A cloud paged in on demand (a large .omh) wants the opposite: address space for every point,
+// memory only for the nodes loaded, given back when a node is evicted. Its arrays ask for
+// small pages (PageSize::Small): a huge page would turn the first write of a 100-point node
+// into 2 MiB resident, and releasing part of one splits it (points/resident_pages.hpp).
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <memory>
 #include <new>
@@ -25,12 +31,19 @@ constexpr std::size_t hugePageArrayBytes(std::size_t bytes) {
     return (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
 }
 
+enum class PageSize {
+    Huge,  // written once, scanned often: fewer faults and TLB misses
+    Small, // written and released piecemeal (ResidentPages)
+};
+
+inline constexpr std::size_t kSmallPageBytes = 4096;
+
 template <typename T> class HugePageArray {
     static_assert(std::is_trivially_copyable_v<T>, "elements are left uninitialised");
 
 public:
     HugePageArray() = default;
-    explicit HugePageArray(std::size_t size) : m_size(size) {
+    explicit HugePageArray(std::size_t size, PageSize pages = PageSize::Huge) : m_size(size) {
         if (size == 0) {
             return;
         }
@@ -39,7 +52,8 @@ public:
         if (memory == nullptr) {
             throw std::bad_alloc();
         }
-        madvise(memory, bytes, MADV_HUGEPAGE); // advice only: a refusal leaves small pages
+        // Advice only: a refusal leaves the kernel's default.
+        madvise(memory, bytes, pages == PageSize::Huge ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
         m_data.reset(static_cast<T*>(memory));
     }
 

@@ -1,5 +1,7 @@
 #include "points/sorted_cloud.hpp"
 
+#include <stdexcept>
+
 namespace omicron {
 
 const char* toString(PointStorage storage) {
@@ -19,13 +21,19 @@ bool parsePointStorage(std::string_view text, PointStorage& out) {
 
 SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffset,
                          AttributeSet attributes, std::size_t capacity, CloudOrder order,
-                         PointStorage storage)
+                         PointStorage storage, PageSize pages)
     : m_cube(cube), m_sourceOffset(sourceOffset), m_attributes(attributes), m_order(order),
-      m_capacity(capacity), m_positions(storage == PointStorage::Exact ? capacity : 0),
-      m_normals(attributes.has(Attribute::Normal) ? capacity : 0),
-      m_colors(storage == PointStorage::Exact && attributes.has(Attribute::Color) ? capacity : 0),
-      m_intensities(attributes.has(Attribute::Intensity) ? capacity : 0),
+      m_capacity(capacity), m_pages(pages),
+      m_positions(storage == PointStorage::Exact ? capacity : 0, pages),
+      m_normals(attributes.has(Attribute::Normal) ? capacity : 0, pages),
+      m_colors(storage == PointStorage::Exact && attributes.has(Attribute::Color) ? capacity : 0,
+               pages),
+      m_intensities(attributes.has(Attribute::Intensity) ? capacity : 0, pages),
       m_blockCodes(order == CloudOrder::Morton ? blockCodeCount(capacity) : 0) {
+    if (pages == PageSize::Small &&
+        (storage != PointStorage::Exact || order != CloudOrder::NodeOrder)) {
+        throw std::invalid_argument("SortedCloud: only an exact node-order cloud is paged");
+    }
     if (storage == PointStorage::Packed) {
         m_packed =
             std::make_unique<PackedPointStore>(capacity, attributes.has(Attribute::Color));

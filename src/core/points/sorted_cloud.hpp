@@ -63,7 +63,7 @@ class SortedCloud {
 public:
     SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffset, AttributeSet attributes,
                 std::size_t capacity, CloudOrder order = CloudOrder::Morton,
-                PointStorage storage = PointStorage::Exact);
+                PointStorage storage = PointStorage::Exact, PageSize pages = PageSize::Huge);
 
     SortedCloud(const SortedCloud&) = delete;
     SortedCloud& operator=(const SortedCloud&) = delete;
@@ -129,7 +129,12 @@ public:
     void publish(std::size_t newSortedEnd);
     void markComplete();
 
-    // Bytes of every array and store the cloud holds.
+    // A cloud paged in on demand (PageSize::Small, exact store, NodeOrder): its arrays are
+    // address space for every point, and a loader writes and releases ranges of them itself,
+    // outside the sortedEnd() protocol (formats/omh_pager.hpp says who may read what, when).
+    bool pagedOnDemand() const { return m_pages == PageSize::Small; }
+
+    // Bytes of every array and store the cloud holds (a paged cloud: the address space).
     std::size_t bytesResident() const;
 
     // Copies [begin, end) into a batch (e.g. for a writer or a test).
@@ -141,6 +146,7 @@ private:
     AttributeSet m_attributes;
     CloudOrder m_order;
     std::size_t m_capacity;
+    PageSize m_pages;
     // On huge pages, uninitialised: the producer writes [0, capacity) before publishing.
     HugePageArray<glm::vec3> m_positions;
     HugePageArray<glm::vec3> m_normals;

@@ -1,0 +1,256 @@
+#include "formats/omh_pager.hpp"
+
+#include "formats/omh_reader.hpp"
+#include "formats/omh_record_decoder.hpp"
+#include "io/input_error.hpp"
+
+#include <algorithm>
+
+namespace omicron {
+
+namespace {
+
+// A request the front has not repeated for this many frames is dropped: the camera moved on.
+constexpr std::uint32_t kStaleFrames = 8;
+
+// Over the budget, eviction goes this far below it, so that loads do not evict one node each.
+constexpr double kEvictTo = 0.875;
+
+} // namespace
+
+std::uint64_t OmhPager::residentBytesPerPoint(const omh::Header& header) {
+    std::uint64_t bytes = sizeof(glm::vec3) + sizeof(std::uint16_t); // position, radius
+    bytes += header.attributes.has(Attribute::Normal) ? sizeof(glm::vec3) : 0;
+    bytes += header.attributes.has(Attribute::Color) ? sizeof(glm::u8vec3) : 0;
+    bytes += header.attributes.has(Attribute::Intensity) ? sizeof(std::uint16_t) : 0;
+    bytes += header.estimatedNormals ? sizeof(std::uint32_t) : 0;
+    return bytes;
+}
+
+OmhPager::OmhPager(const omh::Header& header, std::shared_ptr<SortedCloud> cloud,
+                   Hierarchy& hierarchy, std::uint64_t budgetBytes)
+    : m_header(header), m_bytesPerPoint(residentBytesPerPoint(header)), m_budget(budgetBytes),
+      m_cloud(std::move(cloud)), m_hierarchy(hierarchy), m_stream(header.path),
+      m_decoder(header, *m_cloud, hierarchy.mutableStoredSplats()),
+      m_state(std::make_unique<std::atomic<std::uint8_t>[]>(header.totalNodes)),
+      m_wantedFrame(std::make_unique<std::atomic<std::uint32_t>[]>(header.totalNodes)),
+      m_lastUsed(header.totalNodes, 0) {
+    std::uint64_t base = 0, first = 0;
+    for (const omh::LevelEntry& level : header.levels) {
+        m_levelBase.push_back(base);
+        m_levelFirst.push_back(first);
+        base += level.nodes;
+        first += level.points;
+    }
+    SortedCloud& c = *m_cloud;
+    const std::size_t n = c.capacity();
+    m_pages.addArray(c.mutablePositions().data(), sizeof(glm::vec3), c.mutablePositions().size());
+    m_pages.addArray(c.mutableNormals().data(), sizeof(glm::vec3), c.mutableNormals().size());
+    m_pages.addArray(c.mutableColors().data(), sizeof(glm::u8vec3), c.mutableColors().size());
+    m_pages.addArray(c.mutableIntensities().data(), sizeof(std::uint16_t),
+                     c.mutableIntensities().size());
+    StoredSplats& splats = hierarchy.mutableStoredSplats();
+    m_pages.addArray(splats.mutableRadii().data(), sizeof(std::uint16_t), n);
+    m_pages.addArray(splats.mutableNormals().data(), sizeof(std::uint32_t),
+                     splats.mutableNormals().size());
+    m_loader = std::thread([this] { loaderLoop(); });
+}
+
+OmhPager::~OmhPager() {
+    {
+        std::lock_guard lock(m_mutex);
+        m_stop = true;
+    }
+    m_wake.notify_all();
+    m_loader.join();
+}
+
+bool OmhPager::resident(int level, std::uint32_t index) const {
+    return m_state[nodeId(level, index)].load(std::memory_order_acquire) == Resident;
+}
+
+bool OmhPager::want(int level, std::uint32_t index, double priority) {
+    const std::uint64_t id = nodeId(level, index);
+    const std::uint32_t frame = m_frame.load(std::memory_order_relaxed);
+    m_lastUsed[id] = frame;
+    std::uint8_t state = m_state[id].load(std::memory_order_acquire);
+    if (state == Resident) {
+        return true;
+    }
+    if (state == Absent) {
+        if (!m_state[id].compare_exchange_strong(state, Queued)) {
+            return state == Resident;
+        }
+        m_pending.fetch_add(1, std::memory_order_relaxed);
+    } else if (state != Queued || m_wantedFrame[id].load(std::memory_order_relaxed) == frame) {
+        return false; // loading, failed, or asked for already in this frame
+    }
+    // New, or asked for again in a later frame: the newer request supersedes the older one.
+    m_wantedFrame[id].store(frame, std::memory_order_relaxed);
+    {
+        std::lock_guard lock(m_mutex);
+        m_queue.push(Request{frame, priority, level, index});
+    }
+    m_wake.notify_one();
+    return false;
+}
+
+void OmhPager::hold(int level, std::uint32_t index) {
+    const std::uint64_t id = nodeId(level, index);
+    m_lastUsed[id] = m_frame.load(std::memory_order_relaxed);
+    m_heldBytes += std::uint64_t{m_hierarchy.node(level, index).pointCount} * m_bytesPerPoint;
+}
+
+void OmhPager::endFrame() {
+    const std::uint32_t frame = m_frame.load(std::memory_order_relaxed);
+    {
+        std::lock_guard lock(m_mutex);
+        m_residentList.insert(m_residentList.end(), m_newlyResident.begin(),
+                              m_newlyResident.end());
+        m_newlyResident.clear();
+    }
+    if (m_residentBytes.load(std::memory_order_relaxed) > m_budget) {
+        // Least recently used first among the nodes this frame neither held nor wanted.
+        std::vector<std::size_t> order;
+        for (std::size_t i = 0; i < m_residentList.size(); ++i) {
+            const NodeRef& node = m_residentList[i];
+            if (m_lastUsed[nodeId(node.level, node.index)] < frame) {
+                order.push_back(i);
+            }
+        }
+        std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+            const NodeRef& x = m_residentList[a];
+            const NodeRef& y = m_residentList[b];
+            return m_lastUsed[nodeId(x.level, x.index)] < m_lastUsed[nodeId(y.level, y.index)];
+        });
+        const auto target = static_cast<std::uint64_t>(static_cast<double>(m_budget) * kEvictTo);
+        std::vector<bool> evicted(m_residentList.size(), false);
+        for (std::size_t i : order) {
+            if (m_residentBytes.load(std::memory_order_relaxed) <= target) {
+                break;
+            }
+            evict(m_residentList[i].level, m_residentList[i].index);
+            evicted[i] = true;
+        }
+        std::size_t kept = 0;
+        for (std::size_t i = 0; i < m_residentList.size(); ++i) {
+            if (!evicted[i]) {
+                m_residentList[kept++] = m_residentList[i];
+            }
+        }
+        m_residentList.resize(kept);
+    }
+    m_lastHeldBytes.store(m_heldBytes, std::memory_order_relaxed);
+    m_heldBytes = 0;
+    m_frame.store(frame + 1, std::memory_order_relaxed);
+}
+
+void OmhPager::evict(int level, std::uint32_t index) {
+    const OctreeNode& node = m_hierarchy.node(level, index);
+    // Only this thread reads points, and it stops now: no reader is left when they go.
+    m_state[nodeId(level, index)].store(Absent, std::memory_order_relaxed);
+    m_pages.release(node.coveredBegin, std::size_t{node.coveredBegin} + node.pointCount);
+    m_residentBytes.fetch_sub(std::uint64_t{node.pointCount} * m_bytesPerPoint,
+                              std::memory_order_relaxed);
+    m_residentNodes.fetch_sub(1, std::memory_order_relaxed);
+    m_evictions.fetch_add(1, std::memory_order_relaxed);
+}
+
+void OmhPager::loaderLoop() {
+    for (;;) {
+        Request request;
+        {
+            std::unique_lock lock(m_mutex);
+            m_wake.wait(lock, [&] { return m_stop || !m_queue.empty(); });
+            if (m_stop) {
+                return;
+            }
+            request = m_queue.top();
+            m_queue.pop();
+        }
+        const std::uint64_t id = nodeId(request.level, request.index);
+        if (request.frame != m_wantedFrame[id].load(std::memory_order_relaxed)) {
+            continue; // a later request for the same node is queued
+        }
+        std::uint8_t queued = Queued;
+        if (request.frame + kStaleFrames < m_frame.load(std::memory_order_relaxed)) {
+            if (m_state[id].compare_exchange_strong(queued, Absent)) {
+                m_pending.fetch_sub(1, std::memory_order_relaxed);
+            }
+            continue;
+        }
+        if (m_state[id].compare_exchange_strong(queued, Loading)) {
+            load(request.level, request.index);
+        }
+    }
+}
+
+void OmhPager::load(int level, std::uint32_t index) {
+    const std::uint64_t id = nodeId(level, index);
+    const OctreeNode& node = m_hierarchy.node(level, index);
+    const std::size_t begin = node.coveredBegin;
+    const std::size_t count = node.pointCount;
+    const omh::LevelEntry& entry = m_header.levels[static_cast<std::size_t>(level)];
+    const std::uint64_t offset =
+        entry.payloadOffset + (begin - m_levelFirst[static_cast<std::size_t>(level)]) *
+                                  m_header.recordBytes;
+    m_pages.acquire(begin, begin + count);
+    try {
+        m_records.resize(count * m_header.recordBytes);
+        m_stream.seek(offset);
+        const std::string section = omhSectionAt(m_header, offset);
+        m_stream.readExact(m_records.data(), m_records.size(), section);
+        const std::size_t bad = m_decoder.store(m_records.data(), count, begin, node.code, level);
+        if (bad != count) {
+            throw InputError(InputErrorKind::MalformedValue, m_header.path,
+                             InputLocation::byte(offset + bad * m_header.recordBytes),
+                             "in " + section + ", record " +
+                                 std::to_string(begin + bad - m_levelFirst[static_cast<std::size_t>(level)]) +
+                                 ": the position lies outside the cell of its node");
+        }
+    } catch (const InputError& error) {
+        m_pages.release(begin, begin + count);
+        fail(id, error.what());
+        return;
+    }
+    m_bytesRead.fetch_add(count * m_header.recordBytes, std::memory_order_relaxed);
+    m_residentBytes.fetch_add(count * m_bytesPerPoint, std::memory_order_relaxed);
+    m_residentNodes.fetch_add(1, std::memory_order_relaxed);
+    m_loads.fetch_add(1, std::memory_order_relaxed);
+    {
+        std::lock_guard lock(m_mutex);
+        m_newlyResident.push_back(NodeRef{level, index});
+    }
+    m_state[id].store(Resident, std::memory_order_release);
+    m_pending.fetch_sub(1, std::memory_order_relaxed);
+}
+
+void OmhPager::fail(std::uint64_t id, const std::string& error) {
+    {
+        std::lock_guard lock(m_mutex);
+        if (m_firstError.empty()) {
+            m_firstError = error;
+        }
+    }
+    m_failed.fetch_add(1, std::memory_order_relaxed);
+    m_state[id].store(Failed, std::memory_order_release);
+    m_pending.fetch_sub(1, std::memory_order_relaxed);
+}
+
+ResidencyStats OmhPager::stats() const {
+    ResidencyStats stats;
+    stats.budgetBytes = m_budget;
+    stats.residentBytes = m_residentBytes.load(std::memory_order_relaxed);
+    stats.residentNodes = m_residentNodes.load(std::memory_order_relaxed);
+    stats.heldBytes = m_lastHeldBytes.load(std::memory_order_relaxed);
+    stats.loads = m_loads.load(std::memory_order_relaxed);
+    stats.evictions = m_evictions.load(std::memory_order_relaxed);
+    stats.bytesRead = m_bytesRead.load(std::memory_order_relaxed);
+    stats.pendingLoads = m_pending.load(std::memory_order_relaxed);
+    stats.failedNodes = m_failed.load(std::memory_order_relaxed);
+    std::lock_guard lock(m_mutex);
+    stats.firstError = m_firstError;
+    return stats;
+}
+
+} // namespace omicron

@@ -1,0 +1,56 @@
+#include "formats/omh_record_decoder.hpp"
+
+#include <cmath>
+#include <cstring>
+
+namespace omicron {
+
+namespace {
+
+template <typename T> T loadLe(const std::uint8_t* at) {
+    T value;
+    std::memcpy(&value, at, sizeof(T));
+    return value;
+}
+
+} // namespace
+
+OmhRecordDecoder::OmhRecordDecoder(const omh::Header& header, SortedCloud& cloud,
+                                   StoredSplats& splats)
+    : m_layout(omh::RecordLayout::of(header.attributes, header.estimatedNormals)),
+      m_attributes(header.attributes), m_estimatedNormals(header.estimatedNormals),
+      m_cloud(cloud), m_splats(splats) {}
+
+std::size_t OmhRecordDecoder::store(const std::uint8_t* records, std::size_t count,
+                                    std::size_t point, morton::Code nodeCode, int level) const {
+    const int shift = 3 * (morton::kMaxLevel - level);
+    std::size_t firstBad = count;
+    const std::uint8_t* record = records;
+    for (std::size_t r = 0; r < count; ++r, record += m_layout.bytes) {
+        const std::size_t at = point + r;
+        const auto p = loadLe<glm::vec3>(record);
+        const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+        if ((!finite || (morton::encodeUnit(p.x, p.y, p.z) >> shift) != nodeCode) &&
+            firstBad == count) {
+            firstBad = r;
+        }
+        m_cloud.mutablePositions()[at] = p;
+        if (m_attributes.has(Attribute::Normal)) {
+            m_cloud.mutableNormals()[at] = loadLe<glm::vec3>(record + m_layout.point.normalOffset);
+        }
+        if (m_attributes.has(Attribute::Color)) {
+            m_cloud.mutableColors()[at] = loadLe<glm::u8vec3>(record + m_layout.point.colorOffset);
+        }
+        if (m_attributes.has(Attribute::Intensity)) {
+            m_cloud.mutableIntensities()[at] =
+                loadLe<std::uint16_t>(record + m_layout.point.intensityOffset);
+        }
+        m_splats.setEncoded(at, loadLe<std::uint16_t>(record + m_layout.radiusOffset),
+                            m_estimatedNormals
+                                ? loadLe<std::uint32_t>(record + m_layout.estimatedNormalOffset)
+                                : 0u);
+    }
+    return firstBad;
+}
+
+} // namespace omicron

@@ -1,0 +1,37 @@
+// Decodes .omh point records into a node-order cloud and its stored splat attributes. The
+// whole-file loader (a level at a time, omh_reader) and the pager (a node at a time,
+// omh_pager) share it, so a record means the same to both.
+#pragma once
+
+#include "build/stored_splats.hpp"
+#include "formats/omh_format.hpp"
+#include "points/morton.hpp"
+#include "points/sorted_cloud.hpp"
+
+#include <cstddef>
+#include <cstdint>
+
+namespace omicron {
+
+class OmhRecordDecoder {
+public:
+    OmhRecordDecoder(const omh::Header& header, SortedCloud& cloud, StoredSplats& splats);
+
+    // Writes `count` records, all held by the node `nodeCode` of `level`, to the cloud's
+    // points [point, point + count). Returns the index of the first record whose position is
+    // not finite or lies outside the node's cell, or `count` when every record is good (the
+    // bad ones are written too: the caller decides whether the node is used).
+    std::size_t store(const std::uint8_t* records, std::size_t count, std::size_t point,
+                      morton::Code nodeCode, int level) const;
+
+    std::size_t recordBytes() const { return m_layout.bytes; }
+
+private:
+    omh::RecordLayout m_layout;
+    AttributeSet m_attributes;
+    bool m_estimatedNormals;
+    SortedCloud& m_cloud;
+    StoredSplats& m_splats;
+};
+
+} // namespace omicron
