@@ -174,6 +174,22 @@ int runRender(const std::vector<std::string>& args) {
     const FrameStats stats = view.lastFrameStats();
     std::printf("rendered %zu of %zu points (%zu nodes) at %dx%d into %s\n", stats.pointsDrawn,
                 stats.pointsTotal, stats.nodesDrawn, size.width(), size.height(), outPath.c_str());
+    if (const NodeResidency* paged = hierarchy->residency()) {
+        const ResidencyStats residency = paged->stats();
+        std::printf("points paged in on demand: %llu nodes loaded (%.1f MiB read), %.1f MiB "
+                    "resident of a %.1f MiB budget, %llu evicted\n",
+                    static_cast<unsigned long long>(residency.loads),
+                    static_cast<double>(residency.bytesRead) / (1 << 20),
+                    static_cast<double>(residency.residentBytes) / (1 << 20),
+                    static_cast<double>(residency.budgetBytes) / (1 << 20),
+                    static_cast<unsigned long long>(residency.evictions));
+        if (residency.failedNodes > 0) {
+            std::fprintf(stderr, "omicron-cli: %llu nodes could not be read, their parents were "
+                                 "drawn instead; the first: %s\n",
+                         static_cast<unsigned long long>(residency.failedNodes),
+                         residency.firstError.c_str());
+        }
+    }
     return 0;
 }
 

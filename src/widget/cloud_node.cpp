@@ -1,11 +1,13 @@
 #include "cloud_node.hpp"
 
 #include "build/hierarchy.hpp"
+#include "front/front_projection.hpp"
 #include "shader_library.hpp"
 #include "view_camera.hpp"
 
 #include <QElapsedTimer>
 #include <QOpenGLContext>
+#include <QThread>
 #include <algorithm>
 #include <cmath>
 #include <glm/gtc/type_ptr.hpp>
@@ -24,6 +26,10 @@ constexpr float kSplatDepthOffsetRadii = 1.0f;
 constexpr std::size_t kPackBatchBytes = std::size_t{8} << 20;
 // Screenshots: most front evaluations spent converging before the image is taken.
 constexpr int kMaxSettleEvaluations = 256;
+// Screenshots of a hierarchy paged in on demand: evaluations in a row that must change nothing
+// with no load outstanding, and the most time spent waiting for loads.
+constexpr int kQuietSettleEvaluations = 3;
+constexpr qint64 kMaxPagedSettleMs = 120000;
 
 glm::vec3 levelColor(int level) {
     // Hues spaced by the golden angle: neighbouring levels never look alike.
@@ -46,6 +52,7 @@ void CloudNode::setHierarchy(std::shared_ptr<const Hierarchy> hierarchy) {
     m_hierarchyChanged = true;
     m_drawList.clear();
     m_boundsScanned = 0;
+    m_boundsLevel = -1;
     m_boundsMin = glm::dvec3(1.0);
     m_boundsMax = glm::dvec3(0.0);
 }
@@ -68,6 +75,10 @@ void CloudNode::updateBounds(std::size_t maxPoints) {
         return;
     }
     const SortedCloud& cloud = m_hierarchy->cloud();
+    if (cloud.pagedOnDemand()) {
+        updatePagedBounds();
+        return;
+    }
     const std::size_t published = cloud.sortedEnd();
     if (m_boundsScanned == 0 && published > 0) {
         // The preview's bounds were provisional; the cloud's own points replace them.
@@ -86,6 +97,30 @@ void CloudNode::updateBounds(std::size_t maxPoints) {
     m_boundsMin = glm::dvec3(low);
     m_boundsMax = glm::dvec3(high);
     m_boundsScanned = end;
+}
+
+void CloudNode::updatePagedBounds() {
+    // Its points are read only as the front asks for them, so the nodes stand for them: the
+    // deepest level loaded so far, whose cells hug the points within a cell's edge (1/128 of
+    // the cube at level 7). Node records arrive level by level in a few milliseconds.
+    int deepest = -1;
+    for (int level = 0; level <= m_hierarchy->maxLevel(); ++level) {
+        if (m_hierarchy->nodeCount(level) > 0) {
+            deepest = level;
+        }
+    }
+    if (deepest <= m_boundsLevel) {
+        return;
+    }
+    glm::dvec3 low(1.0), high(0.0);
+    for (std::size_t i = 0; i < m_hierarchy->nodeCount(deepest); ++i) {
+        const CellBox box = cellBox(m_hierarchy->node(deepest, i).code);
+        low = glm::min(low, box.min);
+        high = glm::max(high, box.min + glm::dvec3(box.edge));
+    }
+    m_boundsMin = low;
+    m_boundsMax = high;
+    m_boundsLevel = deepest;
 }
 
 bool CloudNode::boundsPending() const {
@@ -146,19 +181,51 @@ void CloudNode::evaluateFront(RenderContext& context) {
     options.pointBudget = settings.pointBudget;
     options.cpuBudgetMs = context.settle ? 0.0 : settings.frontBudgetMs;
 
+    NodeResidency* residency = m_hierarchy->residency();
+    const auto pendingLoads = [&]() -> std::uint64_t {
+        return residency != nullptr ? residency->stats().pendingLoads : 0;
+    };
     QElapsedTimer timer;
     timer.start();
     int evaluations = 0;
+    int quietEvaluations = 0;
+    std::uint64_t pendingBefore = 0;
     while (true) {
+        // Loads that finish during an evaluation are only seen by the next one.
+        pendingBefore = pendingLoads();
         const FrontEvaluation evaluation = m_front->evaluate(camera, options);
         ++evaluations;
         const bool changed = evaluation.placeholdersInserted + evaluation.substituted +
                                  evaluation.branched + evaluation.pruned >
                              0;
-        if (!context.settle || (!changed && evaluation.finishedSweep) ||
-            evaluations >= kMaxSettleEvaluations) {
+        if (!context.settle) {
             break;
         }
+        if (residency == nullptr) {
+            if ((!changed && evaluation.finishedSweep) || evaluations >= kMaxSettleEvaluations) {
+                break;
+            }
+            continue;
+        }
+        // Paged points: a screenshot waits for the nodes its front asks for, until a few
+        // evaluations in a row change nothing with no load outstanding (or the time limit).
+        const bool quiet = !changed && evaluation.finishedSweep && pendingBefore == 0 &&
+                           pendingLoads() == 0;
+        quietEvaluations = quiet ? quietEvaluations + 1 : 0;
+        if (quietEvaluations == kQuietSettleEvaluations ||
+            timer.elapsed() > kMaxPagedSettleMs) {
+            break;
+        }
+        if (!changed) {
+            QThread::msleep(1); // the loader is reading
+        }
+    }
+    if (residency != nullptr) {
+        const ResidencyStats paged = residency->stats();
+        context.stats->pagedPoints = true;
+        context.stats->pendingLoads = std::max(pendingBefore, paged.pendingLoads);
+        context.stats->pagedResidentBytes = paged.residentBytes;
+        context.stats->pagedBudgetBytes = paged.budgetBytes;
     }
     context.stats->frontMs = static_cast<double>(timer.nsecsElapsed()) * 1e-6;
     context.stats->frontNodes = m_front->entries().size();

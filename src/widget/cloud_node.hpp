@@ -32,7 +32,8 @@ public:
     bool hasPreview() const { return !m_previewVertices.empty() || m_previewVbo != 0; }
 
     // Bounds (unit cube) of the points seen so far: the cloud's published points, else the
-    // preview; empty (min > max) before any.
+    // preview; empty (min > max) before any. A cloud paged in on demand publishes no prefix:
+    // its bounds are the cells of the deepest level loaded so far.
     glm::dvec3 boundsMin() const { return m_boundsMin; }
     glm::dvec3 boundsMax() const { return m_boundsMax; }
     bool hasBounds() const { return m_boundsMin.x <= m_boundsMax.x; }
@@ -78,6 +79,7 @@ private:
     void drawSplats(RenderContext& context);
     void drawComputePoints(RenderContext& context);
     void recordFirstDraws();
+    void updatePagedBounds();
     int effectiveColorMode(const RenderSettings& settings) const;
 
     std::shared_ptr<const Hierarchy> m_hierarchy;
@@ -97,6 +99,7 @@ private:
     int m_previewCount = 0;
 
     std::size_t m_boundsScanned = 0;
+    int m_boundsLevel = -1; // paged: the level whose cells the bounds are
     glm::dvec3 m_boundsMin{1.0};
     glm::dvec3 m_boundsMax{0.0};
 

@@ -73,7 +73,9 @@ public:
             // front sweep cut by its time budget, or points not yet in the bounds.
             return !hierarchy->publishedCut().complete || lastStats.placeholders > 0 ||
                    lastStats.uploads > 0 || lastStats.frontMs >= settings.frontBudgetMs * 0.9 ||
-                   cloud->boundsPending();
+                   cloud->boundsPending() || lastStats.pendingLoads > 0 ||
+                   (hierarchy->residency() != nullptr &&
+                    hierarchy->residency()->stats().pendingLoads > 0);
         }
         return false; // a preview changes only through setPreview(), which repaints
     }

@@ -55,6 +55,13 @@ struct FrameStats {
     std::size_t uploads = 0;       // node buffers uploaded this frame
     std::size_t gpuBytes = 0;      // node buffers resident on the GPU
     bool showingPreview = false;
+    // A hierarchy whose points are paged in on demand (a .omh beyond the memory budget):
+    // node loads asked for and not done, before or after this frame's front evaluation (the
+    // view keeps drawing while any is), and the points in memory against the budget.
+    bool pagedPoints = false;
+    std::uint64_t pendingLoads = 0;
+    std::uint64_t pagedResidentBytes = 0;
+    std::uint64_t pagedBudgetBytes = 0;
     // The paper's front insertion delay: leaves of the builder's insertion log whose points
     // this frame drew for the first time (by their own node or an ancestor standing for them),
     // and the time from the builder publishing each of them to this frame.

@@ -2,6 +2,7 @@
 // pixel statistics of renderImage() from fixed cameras.
 #include "build/hierarchy_builder.hpp"
 #include "cloud_view.hpp"
+#include "formats/omh_writer.hpp"
 #include "io/point_reader.hpp"
 #include "pipeline/build_pipeline.hpp"
 #include "sort/morton_sorter.hpp"
@@ -9,6 +10,7 @@
 
 #include <QElapsedTimer>
 #include <QSignalSpy>
+#include <QTemporaryDir>
 #include <QtTest>
 #include <cmath>
 
@@ -118,6 +120,63 @@ private slots:
         QVERIFY2(pointCoverage > 0.05, qPrintable(QString::number(pointCoverage)));
         QVERIFY2(std::abs(splatCoverage - pointCoverage) < 0.25 * pointCoverage,
                  qPrintable(QString("%1 vs %2").arg(splatCoverage).arg(pointCoverage)));
+    }
+
+    // A .omh beyond the memory budget is drawn with its points paged in on demand: a
+    // screenshot waits for the nodes its front asks for, so it draws what the whole load
+    // draws (framed by the node cells instead of the points: the coverage is close, not
+    // equal); another view evicts what the first one held.
+    void aPagedHierarchyDrawsLikeTheWholeLoadAndEvictsUnderItsBudget() {
+        const QString source = test::sharedDataFile("lion.ply");
+        if (source.isEmpty()) {
+            QSKIP("../shared/data/lion.ply is absent");
+        }
+        QTemporaryDir dir;
+        const std::string omh = dir.filePath("lion.omh").toStdString();
+        {
+            BuildPipeline builder;
+            PipelineOptions options;
+            builder.run(source.toStdString(), options);
+            writeOmh(omh, *builder.hierarchy(),
+                     omhBuildInfo(builder.hierarchyOptions(), builder.statistics()));
+        }
+        BuildPipeline whole;
+        QVERIFY(!whole.run(omh, PipelineOptions{}).pagedPoints);
+        CloudView wholeView;
+        wholeView.setRenderSettings(plainSettings());
+        wholeView.setHierarchy(whole.hierarchy());
+        wholeView.setStandardView(StandardView::Front);
+        const QImage wholeImage = wholeView.renderImage(QSize(400, 400));
+
+        BuildPipeline paged;
+        PipelineOptions budgeted;
+        budgeted.memoryBudgetBytes = 256 * 1024; // a tenth of what the front draws
+        QVERIFY(paged.run(omh, budgeted).pagedPoints);
+        CloudView pagedView;
+        pagedView.setRenderSettings(plainSettings());
+        pagedView.setHierarchy(paged.hierarchy());
+        pagedView.setStandardView(StandardView::Front);
+        const QImage pagedImage = pagedView.renderImage(QSize(400, 400));
+        pagedImage.save("/tmp/lion_paged.png");
+        const FrameStats stats = pagedView.lastFrameStats();
+        QVERIFY(stats.pagedPoints);
+        QCOMPARE(stats.pendingLoads, std::uint64_t{0});
+        QVERIFY(stats.pointsDrawn > 0);
+        const double wholeCoverage = test::coverage(wholeImage, test::viewBackground());
+        const double pagedCoverage = test::coverage(pagedImage, test::viewBackground());
+        QVERIFY2(std::abs(pagedCoverage - wholeCoverage) < 0.15 * wholeCoverage,
+                 qPrintable(QString("%1 vs %2").arg(pagedCoverage).arg(wholeCoverage)));
+
+        NodeResidency& residency = *paged.hierarchy()->residency();
+        const std::uint64_t loadsBefore = residency.stats().loads;
+        pagedView.setStandardView(StandardView::Top);
+        const QImage top = pagedView.renderImage(QSize(400, 400));
+        QVERIFY(test::coverage(top, test::viewBackground()) > 0.02);
+        const ResidencyStats after = residency.stats();
+        QVERIFY2(after.evictions > 0, "the first view's nodes were not given back");
+        QVERIFY(after.loads > loadsBefore);
+        QCOMPARE(after.failedNodes, std::uint64_t{0});
+        QCOMPARE(pagedView.lastFrameStats().pendingLoads, std::uint64_t{0});
     }
 
     // FrameStats carries the front's nodes per level; they add up to the front's size.

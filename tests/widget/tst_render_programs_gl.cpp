@@ -56,6 +56,35 @@ private slots:
         QCOMPARE(QDir(dir.path()).entryList(QDir::Files), QStringList{"lion.png"});
     }
 
+    // A .omh beyond --memory-budget renders with its points paged in on demand: the same
+    // image framing, the nodes it needed read and the rest never loaded.
+    void cliRendersAPagedHierarchyUnderItsBudget() {
+        const QString lion = test::sharedDataFile("lion.ply");
+        if (lion.isEmpty()) {
+            QSKIP("../shared/data/lion.ply is absent");
+        }
+        QTemporaryDir dir;
+        const QString omh = dir.filePath("lion.omh");
+        Run run = runProgram(OMICRON_CLI_PATH, {"build", lion, "--save", omh});
+        QVERIFY2(run.exitCode == 0, qPrintable(run.output));
+        const QString whole = dir.filePath("whole.png");
+        run = runProgram(OMICRON_CLI_PATH,
+                         {"render", omh, "--camera", "front", "--size", "320x240", whole});
+        QVERIFY2(run.exitCode == 0, qPrintable(run.output));
+        QVERIFY2(!run.output.contains("paged"), qPrintable(run.output));
+        const QString paged = dir.filePath("paged.png");
+        run = runProgram(OMICRON_CLI_PATH, {"render", omh, "--camera", "front", "--size",
+                                            "320x240", "--memory-budget", "4M", paged});
+        QVERIFY2(run.exitCode == 0, qPrintable(run.output));
+        QVERIFY2(run.output.contains("points paged in on demand"), qPrintable(run.output));
+        QVERIFY2(run.output.contains("of a 4.0 MiB budget"), qPrintable(run.output));
+        const double wholeCoverage = test::coverage(QImage(whole), test::viewBackground());
+        const double pagedCoverage = test::coverage(QImage(paged), test::viewBackground());
+        QVERIFY2(wholeCoverage > 0.05, qPrintable(QString::number(wholeCoverage)));
+        QVERIFY2(std::abs(pagedCoverage - wholeCoverage) < 0.15 * wholeCoverage,
+                 qPrintable(QString("%1 vs %2").arg(pagedCoverage).arg(wholeCoverage)));
+    }
+
     void cliRenderRejectsBadArgumentsAndInputs() {
         QTemporaryDir dir;
         const QString out = dir.filePath("x.png");

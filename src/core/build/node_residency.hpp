@@ -52,6 +52,9 @@ public:
     virtual void endFrame() = 0;
 
     virtual ResidencyStats stats() const = 0;
+
+    // The file the points are read from (a writer that needs every point copies from it).
+    virtual const std::string& backingFile() const = 0;
 };
 
 } // namespace omicron

@@ -61,6 +61,7 @@ public:
     void hold(int level, std::uint32_t index) override;
     void endFrame() override;
     ResidencyStats stats() const override;
+    const std::string& backingFile() const override { return m_header.path; }
 
 private:
     enum State : std::uint8_t { Absent, Queued, Loading, Resident, Failed };

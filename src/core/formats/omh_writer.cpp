@@ -1,6 +1,7 @@
 #include "formats/omh_writer.hpp"
 
 #include "io/atomic_file_writer.hpp"
+#include "io/file_stream.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -138,6 +139,29 @@ omh::BuildInfo omhBuildInfo(const BuildOptions& options, const BuildStatistics& 
     return build;
 }
 
+namespace {
+
+// Copies the .omh a paged hierarchy reads its points from to `path` (temporary file, then
+// rename: a failure leaves the old target untouched). The source is read through its own
+// descriptor, so copying a file onto itself replaces it while the pager keeps reading the
+// old one.
+void copyPagedSource(const std::string& path, const std::string& source) {
+    FileStream in(source);
+    AtomicFileWriter out(path);
+    std::vector<std::uint8_t> buffer(std::size_t{4} << 20);
+    const std::uint64_t size = in.size();
+    for (std::uint64_t done = 0; done < size;) {
+        const std::size_t count =
+            static_cast<std::size_t>(std::min<std::uint64_t>(buffer.size(), size - done));
+        in.readExact(buffer.data(), count, "the saved hierarchy it was opened from");
+        out.write(buffer.data(), count);
+        done += count;
+    }
+    out.commit();
+}
+
+} // namespace
+
 void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::BuildInfo& build,
               const OmhWriteOptions& options) {
     const auto fail = [&](const std::string& what) {
@@ -149,6 +173,12 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
     if (build.maxLevel != hierarchy.maxLevel()) {
         fail("the build info says depth " + std::to_string(build.maxLevel) +
              ", the hierarchy has depth " + std::to_string(hierarchy.maxLevel()));
+    }
+    if (const NodeResidency* paged = hierarchy.residency()) {
+        // Its points were never all in memory: they are in the .omh it was opened from, and
+        // loading a .omh and saving it again gives the same bytes, so the file is the save.
+        copyPagedSource(path, paged->backingFile());
+        return;
     }
     const SortedCloud& cloud = hierarchy.cloud();
     omh::Header header;

@@ -27,6 +27,9 @@ omh::BuildInfo omhBuildInfo(const BuildOptions& options, const BuildStatistics& 
 // and estimated normal. Loading the file and saving it again gives the same bytes. Throws
 // OutputError naming the file (an incomplete hierarchy, build info that disagrees with it,
 // I/O errors such as a full disk); the temporary file is removed and the target untouched.
+// A hierarchy whose points are paged in on demand (Hierarchy::residency()) is saved as a copy
+// of the .omh it reads them from (the same bytes, as above; `build` is its header's and
+// afterLevel is not called); an unreadable source is an InputError naming it.
 void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::BuildInfo& build,
               const OmhWriteOptions& options = {});
 

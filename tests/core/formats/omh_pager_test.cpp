@@ -268,6 +268,40 @@ TEST(OmhPagedLoad, UnreadableRecordsFailTheirNodeOnlyAndTheParentStaysDrawn) {
     EXPECT_GT(front.entries().size(), 0u);
 }
 
+TEST(OmhPagedLoad, SavingAPagedHierarchyWritesTheSameBytesAndReplacingItsOwnFileWorks) {
+    TempDir dir;
+    const std::string path = saveBuilt(dir, makeCloud(Shape::Random, 30000, 16), 5);
+    const std::vector<std::uint8_t> original = readBytes(path);
+    OmhReader reader(path);
+    reader.pageOnDemand(4096);
+    const auto paged = reader.hierarchy();
+    reader.load();
+    Front front(paged); // some nodes resident, most not: the save must not depend on it
+    settlePaged(front, *paged, lookingAt({0.2, 0.2, 0.5}, 0.1, 1e9), fullDetail());
+    const std::string copy = dir.file("copy.omh");
+    writeOmh(copy, *paged, reader.header().build);
+    EXPECT_EQ(readBytes(copy), original);
+    // Saving over the file it pages from: the pager keeps reading the old file's data.
+    writeOmh(path, *paged, reader.header().build);
+    EXPECT_EQ(readBytes(path), original);
+    settlePaged(front, *paged, lookingAt({0.8, 0.8, 0.5}, 0.1, 1e9), fullDetail());
+    EXPECT_EQ(paged->residency()->stats().failedNodes, 0u);
+    std::size_t files = 0;
+    for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+        ++files;
+    }
+    EXPECT_EQ(files, 2u) << "no temporary left";
+    // A source that is gone is an error naming it; the target keeps its bytes.
+    std::filesystem::remove(path);
+    try {
+        writeOmh(copy, *paged, reader.header().build);
+        ADD_FAILURE() << "saving from a missing source succeeded";
+    } catch (const std::exception& error) {
+        EXPECT_NE(std::string(error.what()).find(path), std::string::npos) << error.what();
+    }
+    EXPECT_EQ(readBytes(copy), original);
+}
+
 TEST(OmhPagedLoad, ThePipelineOpensAHierarchyLargerThanItsBudgetPaged) {
     TempDir dir;
     const std::string path = saveBuilt(dir, makeCloud(Shape::Random, 30000, 15), 5);
