@@ -57,7 +57,8 @@ MainWindow::MainWindow(QWidget* parent)
     m_pointsLabel->setToolTip(tr("Points drawn in the last frame / points of the cloud"));
     m_fpsLabel->setToolTip(tr("Frames per second while the view draws; \"idle\" when nothing "
                               "changed (frames are drawn on demand)"));
-    m_memoryLabel->setToolTip(tr("Resident memory of the process"));
+    m_memoryLabel->setToolTip(tr("Resident memory of the process; for a saved hierarchy larger "
+                                 "than the memory budget, also the points paged in of the budget"));
     statusBar()->addPermanentWidget(m_progressBar);
     statusBar()->addPermanentWidget(m_phaseLabel);
     statusBar()->addPermanentWidget(m_pointsLabel);
@@ -254,6 +255,7 @@ void MainWindow::connectActions() {
         m_cutPanel->setFrontNodes(stats.frontNodesPerLevel);
         m_pointsDrawn = stats.pointsDrawn;
         m_fps = stats.fps;
+        m_lastFrameStats = stats;
         m_lastFrame.start();
     });
 }
@@ -331,10 +333,11 @@ void MainWindow::connectService() {
 
 void MainWindow::openFile(const QString& path) {
     const QFileInfo info(path);
+    // A .omh takes the memory budget only: beyond it, its points are paged in on demand.
+    m_service->setOptions(m_buildPanel->pipelineOptions());
     if (info.suffix().compare(QStringLiteral("omh"), Qt::CaseInsensitive) == 0) {
         m_service->openHierarchy(path);
     } else {
-        m_service->setOptions(m_buildPanel->pipelineOptions());
         m_service->open(path);
     }
     addRecentFile(info.absoluteFilePath());
@@ -492,7 +495,16 @@ void MainWindow::updateStatus() {
     m_fpsLabel->setText(m_lastFrame.isValid() && m_lastFrame.elapsed() < kIdleMs
                             ? tr("%1 fps").arg(m_fps, 0, 'f', 1)
                             : tr("idle"));
-    m_memoryLabel->setText(mib(residentBytes()));
+    // A .omh beyond the memory budget: its points come and go with the view.
+    const FrameStats& frame = m_lastFrameStats;
+    m_memoryLabel->setText(
+        frame.pagedPoints
+            ? tr("%1 (points paged: %2 of %3%4)")
+                  .arg(mib(residentBytes()), mib(frame.pagedResidentBytes),
+                       mib(frame.pagedBudgetBytes),
+                       frame.pendingLoads > 0 ? tr(", %1 nodes loading").arg(frame.pendingLoads)
+                                              : QString())
+            : mib(residentBytes()));
 }
 
 void MainWindow::applyViewParameters(const ViewParameters& parameters) {

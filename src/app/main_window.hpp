@@ -100,6 +100,7 @@ private:
     QTimer m_statusTimer;
     std::size_t m_pointsDrawn = 0;
     double m_fps = 0.0;
+    FrameStats m_lastFrameStats; // the paged-points figures of the last frame
     QElapsedTimer m_lastFrame; // since the view's last frame
 };
 
