@@ -10,9 +10,6 @@ namespace omicron {
 
 namespace {
 
-// A request the front has not repeated for this many frames is dropped: the camera moved on.
-constexpr std::uint32_t kStaleFrames = 8;
-
 // Over the budget, eviction goes this far below it, so that loads do not evict one node each.
 constexpr double kEvictTo = 0.875;
 
@@ -33,7 +30,7 @@ OmhPager::OmhPager(const omh::Header& header, std::shared_ptr<SortedCloud> cloud
       m_cloud(std::move(cloud)), m_hierarchy(hierarchy), m_stream(header.path),
       m_decoder(header, *m_cloud, hierarchy.mutableStoredSplats()),
       m_state(std::make_unique<std::atomic<std::uint8_t>[]>(header.totalNodes)),
-      m_wantedFrame(std::make_unique<std::atomic<std::uint32_t>[]>(header.totalNodes)),
+      m_wantedFrame(header.totalNodes, 0),
       m_lastUsed(header.totalNodes, 0) {
     std::uint64_t base = 0, first = 0;
     for (const omh::LevelEntry& level : header.levels) {
@@ -82,16 +79,13 @@ bool OmhPager::want(int level, std::uint32_t index, double priority) {
             return state == Resident;
         }
         m_pending.fetch_add(1, std::memory_order_relaxed);
-    } else if (state != Queued || m_wantedFrame[id].load(std::memory_order_relaxed) == frame) {
-        return false; // loading, failed, or asked for already in this frame
+    } else if (state != Queued) {
+        return false; // loading or failed
     }
-    // New, or asked for again in a later frame: the newer request supersedes the older one.
-    m_wantedFrame[id].store(frame, std::memory_order_relaxed);
-    {
-        std::lock_guard lock(m_mutex);
-        m_queue.push(Request{frame, priority, level, index});
+    if (m_wantedFrame[id] != frame) { // once a frame
+        m_wantedFrame[id] = frame;
+        m_frameRequests.push_back(Request{priority, level, index});
     }
-    m_wake.notify_one();
     return false;
 }
 
@@ -101,8 +95,29 @@ void OmhPager::hold(int level, std::uint32_t index) {
     m_heldBytes += std::uint64_t{m_hierarchy.node(level, index).pointCount} * m_bytesPerPoint;
 }
 
+void OmhPager::publishRequests(std::uint32_t frame) {
+    std::sort(m_frameRequests.begin(), m_frameRequests.end(),
+              [](const Request& a, const Request& b) { return a.priority < b.priority; });
+    {
+        std::lock_guard lock(m_mutex);
+        m_requests.swap(m_frameRequests);
+    }
+    // The previous frame's requests that this one did not repeat: the camera moved on. The
+    // loader may have taken one already (Loading): the exchange leaves it alone.
+    for (const Request& old : m_frameRequests) {
+        const std::uint64_t id = nodeId(old.level, old.index);
+        std::uint8_t queued = Queued;
+        if (m_wantedFrame[id] != frame && m_state[id].compare_exchange_strong(queued, Absent)) {
+            m_pending.fetch_sub(1, std::memory_order_relaxed);
+        }
+    }
+    m_frameRequests.clear();
+    m_wake.notify_one();
+}
+
 void OmhPager::endFrame() {
     const std::uint32_t frame = m_frame.load(std::memory_order_relaxed);
+    publishRequests(frame);
     {
         std::lock_guard lock(m_mutex);
         m_residentList.insert(m_residentList.end(), m_newlyResident.begin(),
@@ -161,25 +176,16 @@ void OmhPager::loaderLoop() {
         Request request;
         {
             std::unique_lock lock(m_mutex);
-            m_wake.wait(lock, [&] { return m_stop || !m_queue.empty(); });
+            m_wake.wait(lock, [&] { return m_stop || !m_requests.empty(); });
             if (m_stop) {
                 return;
             }
-            request = m_queue.top();
-            m_queue.pop();
-        }
-        const std::uint64_t id = nodeId(request.level, request.index);
-        if (request.frame != m_wantedFrame[id].load(std::memory_order_relaxed)) {
-            continue; // a later request for the same node is queued
+            request = m_requests.back();
+            m_requests.pop_back();
         }
         std::uint8_t queued = Queued;
-        if (request.frame + kStaleFrames < m_frame.load(std::memory_order_relaxed)) {
-            if (m_state[id].compare_exchange_strong(queued, Absent)) {
-                m_pending.fetch_sub(1, std::memory_order_relaxed);
-            }
-            continue;
-        }
-        if (m_state[id].compare_exchange_strong(queued, Loading)) {
+        if (m_state[nodeId(request.level, request.index)].compare_exchange_strong(queued,
+                                                                                 Loading)) {
             load(request.level, request.index);
         }
     }

@@ -12,8 +12,10 @@
 // evicted until the resident points fit the budget.
 //
 // Threads and states. Per node: Absent -> Queued (render thread: want) -> Loading (loader) ->
-// Resident (loader, release store) -> Absent (render thread: eviction). A Queued node the
-// front stopped asking for goes back to Absent (loader). The render thread reads a node's
+// Resident (loader, release store) -> Absent (render thread: eviction). Each frame's requests
+// replace the previous frame's (endFrame), largest on screen first: a Queued node the front
+// stopped asking for goes back to Absent there, so the loader works on what the camera sees
+// now and the request list is never longer than one frame's. The render thread reads a node's
 // points only while it sees Resident (acquire), and only it evicts, so a node is never
 // released under a reader; the loader writes only a Loading node, which nobody reads. One
 // front per paged hierarchy (it owns the frame count).
@@ -37,7 +39,6 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
-#include <queue>
 #include <string>
 #include <thread>
 #include <vector>
@@ -67,18 +68,16 @@ private:
     enum State : std::uint8_t { Absent, Queued, Loading, Resident, Failed };
 
     struct Request {
-        std::uint32_t frame = 0; // the frame that asked: newer first
-        double priority = 0.0;   // then larger first
+        double priority = 0.0; // larger first
         int level = 0;
         std::uint32_t index = 0;
-        bool operator<(const Request& other) const {
-            return frame != other.frame ? frame < other.frame : priority < other.priority;
-        }
     };
 
     std::uint64_t nodeId(int level, std::uint32_t index) const {
         return m_levelBase[static_cast<std::size_t>(level)] + index;
     }
+    // Render thread, end of a frame: this frame's requests replace the last frame's.
+    void publishRequests(std::uint32_t frame);
     void loaderLoop();
     void load(int level, std::uint32_t index);
     void evict(int level, std::uint32_t index);
@@ -97,20 +96,23 @@ private:
     std::vector<std::uint8_t> m_records; // the loader's
 
     std::unique_ptr<std::atomic<std::uint8_t>[]> m_state;
-    std::unique_ptr<std::atomic<std::uint32_t>[]> m_wantedFrame; // the last frame that asked
+    std::vector<std::uint32_t> m_wantedFrame; // render thread: the last frame that asked
     std::vector<std::uint32_t> m_lastUsed;     // render thread: last frame held or wanted
     struct NodeRef {
         int level = 0;
         std::uint32_t index = 0;
     };
     std::vector<NodeRef> m_residentList; // render thread's view of the resident nodes
+    std::vector<Request> m_frameRequests; // render thread: the Queued nodes this frame asked for
     std::atomic<std::uint32_t> m_frame{1};
     std::uint64_t m_heldBytes = 0; // render thread, this frame
     std::atomic<std::uint64_t> m_lastHeldBytes{0};
 
     mutable std::mutex m_mutex; // the queue, the new residents, the error
     std::condition_variable m_wake;
-    std::priority_queue<Request> m_queue;
+    // The last frame's requests, smallest priority first (the loader takes from the back);
+    // each frame's replace the previous ones, so it holds at most what one frame asked for.
+    std::vector<Request> m_requests;
     std::vector<NodeRef> m_newlyResident; // loaded since the render thread last looked
     std::string m_firstError;
     bool m_stop = false;

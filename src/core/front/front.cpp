@@ -123,13 +123,20 @@ bool Front::Impl::childrenReady(const OctreeNode& node, int level) const {
     return settled(hierarchy.node(level + 1, node.firstChild).code);
 }
 
-bool Front::Impl::childrenResident(const OctreeNode& node, int level, double priority) {
-    bool all = true;
+bool Front::Impl::childrenResident(const OctreeNode& node, int level) const {
     for (std::uint32_t child = 0; child < node.childCount; ++child) {
-        // Ask for every missing child at once: they load while the parent stays drawn.
-        all = wantResident(level + 1, std::size_t{node.firstChild} + child, priority) && all;
+        if (!hierarchy.pointsResident(level + 1, std::size_t{node.firstChild} + child)) {
+            return false;
+        }
     }
-    return all;
+    return true;
+}
+
+void Front::Impl::requestChildren(const OctreeNode& node, int level, double priority) {
+    for (std::uint32_t child = 0; child < node.childCount; ++child) {
+        // Every missing child at once: they load while the parent stays drawn.
+        wantResident(level + 1, std::size_t{node.firstChild} + child, priority);
+    }
 }
 
 void Front::Impl::holdEntries() {
@@ -226,7 +233,7 @@ bool Front::Impl::sweep(const FrontOptions& options, FrontEvaluation& result) {
             const OctreeNode& node = hierarchy.node(level, entry.index);
             if (childrenReady(node, level)) {
                 const double sizePx = projectedSizePx(box, camera);
-                if (sizePx > thresholdPx && childrenResident(node, level, sizePx)) {
+                if (sizePx > thresholdPx) {
                     candidates.push_back({written - 1, sizePx});
                 }
             }

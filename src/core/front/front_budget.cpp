@@ -122,7 +122,8 @@ void Front::Impl::applyBudget(const FrontOptions& options, FrontEvaluation& resu
     }
     std::sort(candidates.begin(), candidates.end(),
               [](const BranchCandidate& a, const BranchCandidate& b) { return a.sizePx > b.sizePx; });
-    // marks: 1 = branched, 2 = pruned to make room.
+    // marks: 1 = branched, 2 = pruned to make room (or kept for a branch waiting for its
+    // children), 3 = a branch waiting for its children's points.
     marks.assign(entries.size(), 0);
     operations.clear();
     std::int64_t allowance = static_cast<std::int64_t>(std::min<std::uint64_t>(
@@ -148,6 +149,11 @@ void Front::Impl::applyBudget(const FrontOptions& options, FrontEvaluation& resu
         const OctreeNode& node = hierarchy.node(entry.level(), entry.index);
         const std::int64_t added = childrenVisiblePoints(hierarchy, frustum, node) -
                                    std::int64_t{node.pointCount};
+        // Paged points: a branch whose children are not in memory yet is planned as if it
+        // were made (its room reserved, groups it would prune kept from others) and its
+        // children asked for; it is made in a later evaluation, once they have arrived. So a
+        // frame asks only for what the budget would draw, and draws only what is resident.
+        const bool resident = residency == nullptr || childrenResident(node, entry.level());
         if (added > allowance && makeRoom) {
             // Make room by pruning groups that look smaller than this node: detail moves to
             // where it shows most. Stable from sweep to sweep: the pruned parent is smaller
@@ -174,8 +180,10 @@ void Front::Impl::applyBudget(const FrontOptions& options, FrontEvaluation& resu
                     if (usable) {
                         std::fill_n(marks.begin() + static_cast<std::ptrdiff_t>(group.position),
                                     group.members, std::uint8_t{2});
-                        operations.push_back(
-                            {group.position, group.members, group.parentIndex, false});
+                        if (resident) {
+                            operations.push_back(
+                                {group.position, group.members, group.parentIndex, false});
+                        }
                         allowance += group.pointsFreed;
                     }
                 }
@@ -186,8 +194,13 @@ void Front::Impl::applyBudget(const FrontOptions& options, FrontEvaluation& resu
             }
         }
         if (added <= allowance) {
-            marks[candidate.position] = 1;
-            operations.push_back({candidate.position, 0, entry.index, true});
+            if (resident) {
+                marks[candidate.position] = 1;
+                operations.push_back({candidate.position, 0, entry.index, true});
+            } else {
+                marks[candidate.position] = 3;
+                requestChildren(node, entry.level(), candidate.sizePx);
+            }
             allowance -= added;
         }
     }

@@ -76,7 +76,11 @@ struct Front::Impl {
         return residency == nullptr ||
                residency->want(level, static_cast<std::uint32_t>(index), priority);
     }
-    bool childrenResident(const OctreeNode& node, int level, double priority);
+    // Paged points: whether every child's points are in memory (always, unpaged), and the
+    // request for the missing ones. applyBudget asks only for the children of branches the
+    // point budget allows, so the requests of a frame stay within it.
+    bool childrenResident(const OctreeNode& node, int level) const;
+    void requestChildren(const OctreeNode& node, int level, double priority);
     // Paged points: the entries are held for this frame, the rest may be evicted.
     void holdEntries();
     bool settled(morton::Code code) const {

@@ -217,6 +217,29 @@ TEST(OmhPagedLoad, ATinyBudgetEvictsAndReloadsAndNeverDrawsAMissingNode) {
     EXPECT_LT(positionPages, cloud.capacity() * sizeof(glm::vec3) / page);
 }
 
+TEST(OmhPagedLoad, UnderAPointBudgetOnlyWhatTheBudgetDrawsIsRead) {
+    TempDir dir;
+    const std::string path = saveBuilt(dir, makeCloud(Shape::Random, 120000, 17), 6);
+    OmhReader reader(path);
+    reader.pageOnDemand(std::uint64_t{1} << 30);
+    const auto paged = reader.hierarchy();
+    reader.load();
+    Front front(paged);
+    FrontOptions options = fullDetail();
+    options.pointBudget = 10000;
+    // Full detail is asked everywhere, the budget allows a twelfth of it: the front settles
+    // at the budget and reads about what it draws, not every node it would like to refine.
+    settlePaged(front, *paged, lookingAt({0.5, 0.5, 0.5}, 0.5, 1e9), options);
+    std::uint64_t drawn = 0;
+    for (const FrontEntry& entry : front.entries()) {
+        drawn += paged->node(entry.level(), entry.index).pointCount;
+    }
+    EXPECT_LE(drawn, options.pointBudget);
+    EXPECT_GT(drawn, options.pointBudget / 2);
+    const std::uint64_t pointsRead = paged->residency()->stats().bytesRead / reader.header().recordBytes;
+    EXPECT_LE(pointsRead, 3 * options.pointBudget) << "read " << pointsRead << " points";
+}
+
 TEST(OmhPagedLoad, AFrontMovingEveryFrameKeepsItsInvariantsWhileTheLoaderReads) {
     TempDir dir;
     const std::string path = saveBuilt(dir, makeCloud(Shape::Plane, 80000, 13), 6);
