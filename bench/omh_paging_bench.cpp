@@ -1,7 +1,8 @@
 // Opening a saved hierarchy (.omh) with its points paged in on demand under a memory budget,
 // against loading the whole file and against reading its bytes (the baselines, same run).
 //
-// usage: omh_paging_bench FILE.omh [--budget SIZE | --whole] [--views N] [--width PX]
+// usage: omh_paging_bench FILE [--budget SIZE | --whole] [--views N] [--width PX]
+//   FILE a .omh, or any cloud (built and saved to a temporary .omh first, removed at the end).
 //   SIZE as the CLI takes it (512M, 4G). --whole loads every point (pipeline 3 as before).
 // A front (the view's, without GL) is driven by orthographic cameras of --width pixels
 // (default 1280) across their box, threshold 16 px, point budget 1 M (the app's defaults):
@@ -17,12 +18,15 @@
 // large .omh from a real scan and runs every configuration.
 #include "bench_timing.hpp"
 #include "formats/omh_reader.hpp"
+#include "formats/omh_writer.hpp"
+#include "pipeline/build_pipeline.hpp"
 #include "front/front.hpp"
 #include "memory_budget.hpp"
 
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fcntl.h>
 #include <string>
 #include <sys/resource.h>
@@ -119,7 +123,6 @@ int main(int argc, char** argv) {
                              "[--views N] [--width PX]\n");
         return 2;
     }
-    const std::string path = argv[1];
     std::uint64_t budget = defaultMemoryBudget();
     bool whole = false;
     int views = 8;
@@ -140,7 +143,27 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
+    std::string path = argv[1];
+    // Any cloud: built and saved first, as `omicron-cli build --save` would.
+    struct Scratch {
+        std::string file;
+        ~Scratch() {
+            if (!file.empty()) {
+                std::filesystem::remove(file);
+            }
+        }
+    } scratch;
     try {
+        if (!isOmhFile(path)) {
+            BuildPipeline pipeline;
+            pipeline.run(path, PipelineOptions{});
+            scratch.file = (std::filesystem::temp_directory_path() /
+                            ("omh_paging_bench_" + std::to_string(getpid()) + ".omh"))
+                               .string();
+            writeOmh(scratch.file, *pipeline.hierarchy(),
+                     omhBuildInfo(pipeline.hierarchyOptions(), pipeline.statistics()));
+            path = scratch.file;
+        }
         const double rawMs = rawReadMs(path);
         const auto start = Clock::now();
         OmhReader reader(path);
@@ -179,7 +202,8 @@ int main(int argc, char** argv) {
         }
         std::sort(detailMs.begin(), detailMs.end());
 
-        std::printf("file=%s\n", path.c_str());
+        std::printf("bench=omh_paging\n");
+        std::printf("file=%s\n", argv[1]);
         std::printf("mode=%s\n", whole ? "whole" : "paged");
         std::printf("file_mb=%.1f\n", static_cast<double>(reader.header().fileBytes) / (1 << 20));
         std::printf("points=%llu\n",

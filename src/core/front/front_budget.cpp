@@ -52,11 +52,10 @@ void Front::Impl::collectPrunableGroups(double parentSizeBelowPx) {
                 const OctreeNode& parent = hierarchy.node(parentLevel, *parentIndex);
                 const CellBox box = cellBox(parentCode);
                 const double parentSizePx = projectedSizePx(box, camera);
-                // Paged points: a parent not in memory cannot replace its children yet.
-                if (parent.childCount == end - i &&
-                    (parentSizePx >= parentSizeBelowPx ||
-                     wantResident(parentLevel, *parentIndex, parentSizePx))) {
+                if (parent.childCount == end - i) {
                     PrunableGroup group;
+                    group.parentLevel = parentLevel;
+                    group.parentResident = hierarchy.pointsResident(parentLevel, *parentIndex);
                     group.position = i;
                     group.members = static_cast<std::uint32_t>(end - i);
                     group.parentIndex = static_cast<std::uint32_t>(*parentIndex);
@@ -100,7 +99,7 @@ void Front::Impl::applyBudget(const FrontOptions& options, FrontEvaluation& resu
             operations.clear();
             std::int64_t excess = static_cast<std::int64_t>(visiblePoints - budget);
             for (const PrunableGroup& group : groups) {
-                if (group.pointsFreed <= 0) {
+                if (group.pointsFreed <= 0 || !prunableNow(group)) {
                     continue;
                 }
                 operations.push_back({group.position, group.members, group.parentIndex, false});
@@ -133,7 +132,7 @@ void Front::Impl::applyBudget(const FrontOptions& options, FrontEvaluation& resu
     const auto usableFor = [&](const PrunableGroup& group, const BranchCandidate& candidate) {
         const auto begin = static_cast<std::ptrdiff_t>(group.position);
         const auto end = static_cast<std::ptrdiff_t>(group.position + group.members);
-        return group.pointsFreed > 0 &&
+        return group.pointsFreed > 0 && group.parentResident &&
                !(candidate.position >= group.position &&
                  candidate.position < group.position + group.members) &&
                std::all_of(marks.begin() + begin, marks.begin() + end,
@@ -171,6 +170,8 @@ void Front::Impl::applyBudget(const FrontOptions& options, FrontEvaluation& resu
                 const bool usable = usableFor(group, candidate);
                 if (usable) {
                     freed += group.pointsFreed;
+                } else if (!group.parentResident) {
+                    prunableNow(group); // asks for the parent: usable in a later evaluation
                 }
             }
             if (added <= allowance + freed) {

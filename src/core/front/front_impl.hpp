@@ -49,6 +49,8 @@ struct Front::Impl {
         double parentSizePx = 0.0;
         bool parentVisible = false;
         std::int64_t pointsFreed = 0; // visible points the prune removes
+        int parentLevel = 0;
+        bool parentResident = true; // paged points: the parent can replace the group now
     };
 
     // An operation of a rebuild (end of a call): the entries [position, position + members)
@@ -80,6 +82,12 @@ struct Front::Impl {
     // request for the missing ones. applyBudget asks only for the children of branches the
     // point budget allows, so the requests of a frame stay within it.
     bool childrenResident(const OctreeNode& node, int level) const;
+    // Paged points: a group may be pruned now when its parent is in memory; otherwise the
+    // parent is asked for (only for the groups a prune would use).
+    bool prunableNow(const PrunableGroup& group) {
+        return group.parentResident ||
+               wantResident(group.parentLevel, group.parentIndex, group.parentSizePx);
+    }
     void requestChildren(const OctreeNode& node, int level, double priority);
     // Paged points: the entries are held for this frame, the rest may be evicted.
     void holdEntries();
