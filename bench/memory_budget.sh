@@ -21,14 +21,7 @@ cli=build/release/bin/omicron-cli
 work=$(mktemp -d "${BENCH_DIR:-/tmp}/omicron-memory-bench-XXXXXX")
 trap 'rm -rf "$work"' EXIT
 
-# Runs a command under /usr/bin/time -v; prints "wall user sys peak_kib".
-measure() {
-  /usr/bin/time -v -o "$work/time.txt" "$@" > "$work/out.txt" 2> "$work/err.txt"
-  awk -F': ' '/Elapsed \(wall clock\)/ { n = split($2, t, ":"); wall = (n == 3) ? t[1]*3600 + t[2]*60 + t[3] : t[1]*60 + t[2] }
-              /User time/ { user = $2 } /System time/ { sys = $2 }
-              /Maximum resident set size/ { rss = $2 }
-              END { printf "%.2f %.2f %.2f %d\n", wall, user, sys, rss }' "$work/time.txt"
-}
+source bench/measure.sh
 
 points=$("$cli" info "$input" | awk '/^points:/ { print $2 }')
 read -r wall user sys rss < <(measure sh -c "cat '$input' > '$work/copy'")

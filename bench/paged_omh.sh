@@ -27,20 +27,14 @@ bench=build/release/bin/omh_paging_bench
 work=$(mktemp -d "${BENCH_DIR:-/tmp}/omicron-paged-bench-XXXXXX")
 trap 'rm -rf "$work"' EXIT
 
-# Runs a command under /usr/bin/time -v; prints "wall peak_mib".
-measure() {
-  /usr/bin/time -v -o "$work/time.txt" "$@" > "$work/out.txt" 2> "$work/err.txt"
-  awk -F': ' '/Elapsed \(wall clock\)/ { n = split($2, t, ":"); wall = (n == 3) ? t[1]*3600 + t[2]*60 + t[3] : t[1]*60 + t[2] }
-              /Maximum resident set size/ { rss = $2 }
-              END { printf "%.2f %d\n", wall, rss / 1024 }' "$work/time.txt"
-}
+source bench/measure.sh
 
-read -r wall rss < <(measure "$cli" tile "$source_cloud" "$work/big.ply" --copies "$copies")
+read -r wall _ _ rss < <(measure "$cli" tile "$source_cloud" "$work/big.ply" --copies "$copies")
 points=$("$cli" info "$work/big.ply" | awk '/^points:/ { print $2 }')
-echo "bench=paged_omh step=tile copies=$copies points=$points bytes=$(stat -c %s "$work/big.ply") wall_s=$wall peak_rss_mib=$rss"
-read -r wall rss < <(measure "$cli" build "$work/big.ply" --store packed --save "$work/big.omh")
+echo "bench=paged_omh step=tile copies=$copies points=$points bytes=$(stat -c %s "$work/big.ply") wall_s=$wall peak_rss_mib=$((rss / 1024))"
+read -r wall _ _ rss < <(measure "$cli" build "$work/big.ply" --store packed --save "$work/big.omh")
 rm -f "$work/big.ply"
-echo "bench=paged_omh step=build points=$points omh_bytes=$(stat -c %s "$work/big.omh") wall_s=$wall peak_rss_mib=$rss"
+echo "bench=paged_omh step=build points=$points omh_bytes=$(stat -c %s "$work/big.omh") wall_s=$wall peak_rss_mib=$((rss / 1024))"
 
 half_kib=$(awk '/MemTotal/ { print int($2 / 2) }' /proc/meminfo)
 omh_kib=$(( $(stat -c %s "$work/big.omh") / 1024 ))

@@ -39,6 +39,14 @@ std::shared_ptr<const Hierarchy> loadWhole(const std::string& path) {
     return hierarchy;
 }
 
+// Opens `reader`'s file with its points paged in on demand under `budget`: nodes only.
+std::shared_ptr<const Hierarchy> openPaged(OmhReader& reader, std::uint64_t budget) {
+    reader.pageOnDemand(budget);
+    auto hierarchy = reader.hierarchy();
+    reader.load();
+    return hierarchy;
+}
+
 FrontOptions fullDetail() {
     FrontOptions options;
     options.projectionThresholdPx = 0.0;
@@ -145,9 +153,7 @@ TEST(OmhPagedLoad, NodesOnlyAtOpenThenEveryLeafOnDemandEqualToTheWholeLoad) {
     const auto whole = loadWhole(path);
 
     OmhReader reader(path);
-    reader.pageOnDemand(std::uint64_t{1} << 30); // everything fits: nothing is evicted
-    const auto paged = reader.hierarchy();
-    reader.load();
+    const auto paged = openPaged(reader, std::uint64_t{1} << 30); // everything fits: nothing is evicted
     ASSERT_NE(paged->residency(), nullptr);
     EXPECT_TRUE(paged->cloud().pagedOnDemand());
     EXPECT_EQ(paged->residency()->stats().loads, 0u) << "opening reads nodes, not points";
@@ -182,9 +188,7 @@ TEST(OmhPagedLoad, ATinyBudgetEvictsAndReloadsAndNeverDrawsAMissingNode) {
     OmhReader reader(path);
     const std::uint64_t all = reader.residentBytesOfAllPoints();
     const std::uint64_t budget = all / 24; // more than one corner needs, less than two
-    reader.pageOnDemand(budget);
-    const auto paged = reader.hierarchy();
-    reader.load();
+    const auto paged = openPaged(reader, budget);
     Front front(paged);
 
     // Full detail of one corner, then another, then the first again: the second evicts the
@@ -221,9 +225,7 @@ TEST(OmhPagedLoad, UnderAPointBudgetOnlyWhatTheBudgetDrawsIsRead) {
     TempDir dir;
     const std::string path = saveBuilt(dir, makeCloud(Shape::Random, 120000, 17), 6);
     OmhReader reader(path);
-    reader.pageOnDemand(std::uint64_t{1} << 30);
-    const auto paged = reader.hierarchy();
-    reader.load();
+    const auto paged = openPaged(reader, std::uint64_t{1} << 30);
     Front front(paged);
     FrontOptions options = fullDetail();
     options.pointBudget = 10000;
@@ -245,9 +247,7 @@ TEST(OmhPagedLoad, AFrontMovingEveryFrameKeepsItsInvariantsWhileTheLoaderReads) 
     const std::string path = saveBuilt(dir, makeCloud(Shape::Plane, 80000, 13), 6);
     const auto whole = loadWhole(path);
     OmhReader reader(path);
-    reader.pageOnDemand(reader.residentBytesOfAllPoints() / 8);
-    const auto paged = reader.hierarchy();
-    reader.load();
+    const auto paged = openPaged(reader, reader.residentBytesOfAllPoints() / 8);
     Front front(paged);
     // A camera sweeping across the cube, one evaluation per position, never waiting for the
     // loader: nodes arrive while the front moves on.
@@ -269,9 +269,7 @@ TEST(OmhPagedLoad, UnreadableRecordsFailTheirNodeOnlyAndTheParentStaysDrawn) {
     TempDir dir;
     const std::string path = saveBuilt(dir, makeCloud(Shape::Random, 30000, 14), 5);
     OmhReader reader(path);
-    reader.pageOnDemand(std::uint64_t{1} << 30);
-    const auto paged = reader.hierarchy();
-    reader.load();
+    const auto paged = openPaged(reader, std::uint64_t{1} << 30);
     // The file loses its deepest level's records after it was opened (a disk unmounted, a
     // file replaced): those nodes cannot be read.
     const omh::Header& header = reader.header();
@@ -296,9 +294,7 @@ TEST(OmhPagedLoad, SavingAPagedHierarchyWritesTheSameBytesAndReplacingItsOwnFile
     const std::string path = saveBuilt(dir, makeCloud(Shape::Random, 30000, 16), 5);
     const std::vector<std::uint8_t> original = readBytes(path);
     OmhReader reader(path);
-    reader.pageOnDemand(4096);
-    const auto paged = reader.hierarchy();
-    reader.load();
+    const auto paged = openPaged(reader, 4096);
     Front front(paged); // some nodes resident, most not: the save must not depend on it
     settlePaged(front, *paged, lookingAt({0.2, 0.2, 0.5}, 0.1, 1e9), fullDetail());
     const std::string copy = dir.file("copy.omh");
