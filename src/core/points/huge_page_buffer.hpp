@@ -18,6 +18,7 @@
 #include <cstdlib>
 #include <memory>
 #include <new>
+#include <string>
 #include <span>
 #include <sys/mman.h>
 #include <type_traits>
@@ -36,6 +37,22 @@ enum class PageSize {
     Small, // written and released piecemeal (ResidentPages)
 };
 
+// A sorted cloud larger than the memory budget keeps its arrays in a scratch file instead
+// (points/file_backed_memory.hpp): the same addresses, but the kernel may write the pages
+// back and the owner drops them from its resident set (dropResident), and reading them again
+// faults them back in from the page cache or the file.
+struct FileBacking {
+    std::string folder; // where the unnamed scratch file lives (removed when unmapped)
+};
+
+// Maps `bytes` of a new unnamed file in `folder` (space reserved up front); throws
+// std::runtime_error naming the folder and the bytes when it cannot.
+void* mapScratchFile(const std::string& folder, std::size_t bytes);
+void unmapScratchFile(void* memory, std::size_t bytes);
+// Gives the pages of [memory, memory + bytes) back (file-backed: their data stays in the
+// file and the page cache).
+void dropResidentPages(void* memory, std::size_t bytes);
+
 inline constexpr std::size_t kSmallPageBytes = 4096;
 
 template <typename T> class HugePageArray {
@@ -43,6 +60,15 @@ template <typename T> class HugePageArray {
 
 public:
     HugePageArray() = default;
+    // In a scratch file (see FileBacking).
+    HugePageArray(std::size_t size, const FileBacking& backing) : m_size(size) {
+        if (size == 0) {
+            return;
+        }
+        m_mappedBytes = hugePageArrayBytes(size * sizeof(T));
+        m_data.reset(static_cast<T*>(mapScratchFile(backing.folder, m_mappedBytes)));
+        m_data.get_deleter().mappedBytes = m_mappedBytes;
+    }
     explicit HugePageArray(std::size_t size, PageSize pages = PageSize::Huge) : m_size(size) {
         if (size == 0) {
             return;
@@ -68,12 +94,29 @@ public:
     operator std::span<T>() { return {m_data.get(), m_size}; }
     operator std::span<const T>() const { return {m_data.get(), m_size}; }
 
+    bool fileBacked() const { return m_mappedBytes != 0; }
+    // File-backed only: the array's pages leave the resident set (any thread; readers and
+    // writers may go on: a page they touch next is faulted back in with its data).
+    void dropResident() const {
+        if (m_mappedBytes != 0) {
+            dropResidentPages(m_data.get(), m_mappedBytes);
+        }
+    }
+
 private:
     struct Free {
-        void operator()(T* pointer) const { std::free(pointer); }
+        std::size_t mappedBytes = 0; // > 0: a scratch-file mapping
+        void operator()(T* pointer) const {
+            if (mappedBytes != 0) {
+                unmapScratchFile(pointer, mappedBytes);
+            } else {
+                std::free(pointer);
+            }
+        }
     };
     std::unique_ptr<T[], Free> m_data;
     std::size_t m_size = 0;
+    std::size_t m_mappedBytes = 0;
 };
 
 } // namespace omicron

@@ -40,6 +40,26 @@ SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffs
     }
 }
 
+SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffset,
+                         AttributeSet attributes, std::size_t capacity, const FileBacking& backing,
+                         std::uint64_t budgetBytes)
+    : m_cube(cube), m_sourceOffset(sourceOffset), m_attributes(attributes),
+      m_order(CloudOrder::Morton), m_capacity(capacity), m_pages(PageSize::Huge),
+      m_positions(capacity, backing),
+      m_normals(attributes.has(Attribute::Normal) ? capacity : 0, backing),
+      m_colors(attributes.has(Attribute::Color) ? capacity : 0, backing),
+      m_intensities(attributes.has(Attribute::Intensity) ? capacity : 0, backing),
+      m_blockCodes(blockCodeCount(capacity)) {
+    m_governor = std::make_unique<ResidentSetGovernor>(budgetBytes, [this] {
+        m_positions.dropResident();
+        m_normals.dropResident();
+        m_colors.dropResident();
+        m_intensities.dropResident();
+    });
+}
+
+SortedCloud::~SortedCloud() = default;
+
 SortedCloud::StagedRange SortedCloud::stage(std::size_t end) {
     const std::size_t begin = m_sortedEnd.load(std::memory_order_relaxed);
     assert(begin <= end && end <= m_capacity);
@@ -90,9 +110,14 @@ void SortedCloud::markComplete() {
 }
 
 std::size_t SortedCloud::bytesResident() const {
-    return positions().size_bytes() + normals().size_bytes() + colors().size_bytes() +
-           intensities().size_bytes() + m_blockCodes.size() * sizeof(morton::Code) +
+    const std::size_t arrays = positions().size_bytes() + normals().size_bytes() +
+                               colors().size_bytes() + intensities().size_bytes();
+    return (fileBacked() ? 0 : arrays) + m_blockCodes.size() * sizeof(morton::Code) +
            (m_packed ? m_packed->bytesResident() : 0);
+}
+
+std::uint64_t SortedCloud::residentDrops() const {
+    return m_governor ? m_governor->drops() : 0;
 }
 
 void SortedCloud::copyRange(std::size_t begin, std::size_t end, PointBatch& out) const {

@@ -24,6 +24,7 @@
 #include "points/block_codes.hpp"
 #include "points/cube_transform.hpp"
 #include "points/huge_page_buffer.hpp"
+#include "points/resident_set_governor.hpp"
 #include "points/morton.hpp"
 #include "points/packed_points.hpp"
 #include "points/point_batch.hpp"
@@ -64,6 +65,14 @@ public:
     SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffset, AttributeSet attributes,
                 std::size_t capacity, CloudOrder order = CloudOrder::Morton,
                 PointStorage storage = PointStorage::Exact, PageSize pages = PageSize::Huge);
+    // A Morton-ordered exact cloud whose arrays live in an unnamed scratch file under
+    // `backing.folder` (space reserved now; std::runtime_error naming the folder when it
+    // cannot be), for a cloud larger than the memory budget: a thread drops the arrays' pages
+    // from the resident set whenever the process exceeds `budgetBytes`
+    // (points/resident_set_governor.hpp). Readers and the producer use it as any other cloud.
+    SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffset, AttributeSet attributes,
+                std::size_t capacity, const FileBacking& backing, std::uint64_t budgetBytes);
+    ~SortedCloud();
 
     SortedCloud(const SortedCloud&) = delete;
     SortedCloud& operator=(const SortedCloud&) = delete;
@@ -133,8 +142,13 @@ public:
     // address space for every point, and a loader writes and releases ranges of them itself,
     // outside the sortedEnd() protocol (formats/omh_pager.hpp says who may read what, when).
     bool pagedOnDemand() const { return m_pages == PageSize::Small; }
+    // Its arrays are in a scratch file, kept out of memory beyond the budget.
+    bool fileBacked() const { return m_governor != nullptr; }
+    // File-backed: how often the arrays' pages were dropped to stay within the budget.
+    std::uint64_t residentDrops() const;
 
-    // Bytes of every array and store the cloud holds (a paged cloud: the address space).
+    // Bytes of every array and store the cloud holds in memory (a paged cloud: the address
+    // space; a file-backed one: only its block codes, the arrays are in the file).
     std::size_t bytesResident() const;
 
     // Copies [begin, end) into a batch (e.g. for a writer or a test).
@@ -158,6 +172,8 @@ private:
     std::vector<glm::u8vec3> m_stagedColors;
     std::atomic<std::size_t> m_sortedEnd{0};
     std::atomic<bool> m_complete{false};
+    // File-backed only; last, so its thread stops before the arrays it drops go.
+    std::unique_ptr<ResidentSetGovernor> m_governor;
 };
 
 } // namespace omicron

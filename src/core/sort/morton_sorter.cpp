@@ -1,8 +1,10 @@
 #include "sort/morton_sorter.hpp"
 
+#include "io/atomic_file_writer.hpp"
 #include "memory_budget.hpp"
 #include "sort/radix_sort.hpp"
 #include "sort/run_merger.hpp"
+#include "sort/scratch_folder.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -32,6 +34,13 @@ std::uint64_t batchBytesPerPoint(AttributeSet attributes) {
 // block and what the stages after the sort keep.
 constexpr std::uint64_t kMinRunPoints = 4096;
 
+// Bytes a point takes in an exact sorted cloud.
+std::uint64_t exactBytesPerPoint(AttributeSet attributes) {
+    return sizeof(glm::vec3) + (attributes.has(Attribute::Normal) ? sizeof(glm::vec3) : 0) +
+           (attributes.has(Attribute::Color) ? sizeof(glm::u8vec3) : 0) +
+           (attributes.has(Attribute::Intensity) ? sizeof(std::uint16_t) : 0);
+}
+
 } // namespace
 
 std::uint64_t IncrementalMortonSorter::inMemoryBytes(const CloudInfo& info) {
@@ -53,17 +62,35 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
         m_options.memoryBudgetBytes != 0 ? m_options.memoryBudgetBytes : defaultMemoryBudget();
     m_options.memoryBudgetBytes = budget;
     const auto capacity = static_cast<std::size_t>(info.pointCount);
-    m_cloud =
-        std::make_shared<SortedCloud>(info.cube, info.sourceOffset, info.attributes, capacity,
-                                      CloudOrder::Morton, m_options.storage);
-    m_input.attributes = info.attributes;
-    if (inMemoryBytes(info) > budget) {
+    const bool spills = inMemoryBytes(info) > budget;
+    if (spills) {
+        // First: it checks the scratch folder and its free space.
         const std::uint64_t runPoints =
             std::max(kMinRunPoints, budget / 2 / RunSpiller::bytesPerBufferedPoint(info.attributes));
         m_spiller = std::make_unique<RunSpiller>(
             m_options.tempDir, info.attributes,
             static_cast<std::size_t>(std::min<std::uint64_t>(runPoints, capacity)),
             info.pointCount);
+    }
+    if (spills && m_options.storage == PointStorage::Exact &&
+        info.pointCount * exactBytesPerPoint(info.attributes) > budget / 2) {
+        // Even sorted, the points would take more than half the budget: the cloud goes to a
+        // scratch file, and its pages leave memory whenever the process exceeds the budget.
+        const std::string folder =
+            m_options.tempDir.empty() ? ScratchFolder::defaultParent() : m_options.tempDir;
+        try {
+            m_cloud = std::make_shared<SortedCloud>(info.cube, info.sourceOffset, info.attributes,
+                                                    capacity, FileBacking{folder}, budget);
+        } catch (const std::runtime_error& error) {
+            throw OutputError(error.what());
+        }
+    } else {
+        m_cloud =
+            std::make_shared<SortedCloud>(info.cube, info.sourceOffset, info.attributes, capacity,
+                                          CloudOrder::Morton, m_options.storage);
+    }
+    m_input.attributes = info.attributes;
+    if (spills) {
         return;
     }
     m_bins.resize(kBins);

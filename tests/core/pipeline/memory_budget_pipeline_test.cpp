@@ -36,6 +36,7 @@ std::size_t entriesIn(const std::filesystem::path& folder) {
 struct Built {
     PipelineResult result;
     std::uint64_t print = 0;
+    bool fileBacked = false; // the sorted cloud lived in a scratch file
 };
 
 Built build(const std::string& path, const PipelineOptions& o, bool withSplats) {
@@ -46,6 +47,7 @@ Built build(const std::string& path, const PipelineOptions& o, bool withSplats) 
     EXPECT_TRUE(built.result.stats.invariantViolation.empty())
         << built.result.stats.invariantViolation;
     built.print = test::fingerprint(*pipeline.hierarchy(), withSplats);
+    built.fileBacked = pipeline.sortedCloud() && pipeline.sortedCloud()->fileBacked();
     return built;
 }
 
@@ -56,6 +58,11 @@ void expectSameBuild(const std::string& path, LeafCollapse collapse, bool withSp
     const Built spilled =
         build(path, options(kMinMemoryBudget, scratch.path().string(), collapse), withSplats);
     EXPECT_GT(spilled.result.sortRuns, 1u);
+    EXPECT_FALSE(inMemory.fileBacked);
+    // Sorted points over half the budget go to a scratch file (positions alone: 12 bytes).
+    if (spilled.result.stats.inputPoints * sizeof(glm::vec3) > kMinMemoryBudget / 2) {
+        EXPECT_TRUE(spilled.fileBacked) << "the sorted points stayed in memory beyond the budget";
+    }
     EXPECT_EQ(spilled.print, inMemory.print) << "the hierarchies differ";
     ASSERT_EQ(spilled.result.stats.levels.size(), inMemory.result.stats.levels.size());
     for (std::size_t level = 0; level < inMemory.result.stats.levels.size(); ++level) {

@@ -255,7 +255,10 @@ TEST(ExternalSortCleanup, AFullDiskIsAClearErrorAndLeavesNothing) {
     test::TempDir dir;
     test::TempDir scratch;
     const std::string path = writeAdversarialCloud(dir, 300'000);
-    const SortOptions spilling = spillingOptions(scratch);
+    SortOptions spilling = spillingOptions(scratch);
+    // Packed: the sorted cloud stays in memory, so the runs are the first to hit the limit
+    // (the file-backed cloud's own reservation is the next test).
+    spilling.storage = PointStorage::Packed;
     auto reader = openPointCloud(path);
     const std::uint64_t needed =
         reader->info().pointCount * PointRecordLayout::of(reader->info().attributes).bytes;
@@ -280,6 +283,36 @@ TEST(ExternalSortCleanup, AFullDiskIsAClearErrorAndLeavesNothing) {
         message.find("need " + formatByteSize(needed) + " (" + std::to_string(needed) + " bytes)"),
         std::string::npos)
         << message;
+    EXPECT_NE(message.find("--temp-dir"), std::string::npos) << message;
+    EXPECT_EQ(entriesIn(scratch.path()), 0u);
+}
+
+// An exact cloud beyond the budget lives in a scratch file whose space is reserved up front:
+// no room there is an error naming the folder and the bytes before a point is read, and
+// nothing is left behind.
+TEST(ExternalSortCleanup, NoRoomForTheFileBackedCloudIsAClearErrorUpFront) {
+    test::TempDir dir;
+    test::TempDir scratch;
+    const std::string path = writeAdversarialCloud(dir, 300'000);
+    const SortOptions spilling = spillingOptions(scratch);
+    auto reader = openPointCloud(path);
+    rlimit previous{};
+    ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &previous), 0);
+    const auto previousHandler = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit limited = previous;
+    limited.rlim_cur = 1024 * 1024; // less than the cloud's 300,000 x 15 bytes
+    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limited), 0);
+    std::string message;
+    try {
+        IncrementalMortonSorter sorter(reader->info(), spilling);
+    } catch (const OutputError& error) {
+        message = error.what();
+    }
+    setrlimit(RLIMIT_FSIZE, &previous);
+    std::signal(SIGXFSZ, previousHandler);
+    ASSERT_FALSE(message.empty()) << "the sorter did not reserve the cloud's space";
+    EXPECT_EQ(message.rfind(scratch.path().string() + ": cannot keep ", 0), 0u) << message;
+    EXPECT_NE(message.find("sorted points beyond the memory budget"), std::string::npos) << message;
     EXPECT_NE(message.find("--temp-dir"), std::string::npos) << message;
     EXPECT_EQ(entriesIn(scratch.path()), 0u);
 }

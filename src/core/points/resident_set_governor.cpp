@@ -1,0 +1,70 @@
+#include "points/resident_set_governor.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <unistd.h>
+
+namespace omicron {
+
+namespace {
+
+// How often the resident set is looked at, and how long to wait while the process's own
+// (anonymous) memory is over the limit alone: dropping file pages then would only make the
+// cloud's readers fault for nothing.
+constexpr auto kInterval = std::chrono::milliseconds(2);
+constexpr auto kBackOff = std::chrono::milliseconds(250);
+
+} // namespace
+
+ResidentSetGovernor::ResidentSetGovernor(std::uint64_t limitBytes, std::function<void()> drop)
+    : m_limit(limitBytes), m_drop(std::move(drop)), m_thread([this] { run(); }) {}
+
+ResidentSetGovernor::~ResidentSetGovernor() {
+    {
+        std::lock_guard lock(m_mutex);
+        m_stop = true;
+    }
+    m_wake.notify_all();
+    m_thread.join();
+}
+
+namespace {
+
+// Resident and file-backed resident bytes from /proc/self/statm (zeros where unreadable).
+std::pair<std::uint64_t, std::uint64_t> readStatm() {
+    std::FILE* file = std::fopen("/proc/self/statm", "r");
+    if (file == nullptr) {
+        return {0, 0};
+    }
+    unsigned long long pages = 0, resident = 0, shared = 0;
+    const int read = std::fscanf(file, "%llu %llu %llu", &pages, &resident, &shared);
+    std::fclose(file);
+    const auto page = static_cast<std::uint64_t>(sysconf(_SC_PAGESIZE));
+    return read == 3 ? std::pair{resident * page, shared * page} : std::pair{0ull, 0ull};
+}
+
+} // namespace
+
+std::uint64_t ResidentSetGovernor::residentBytes() { return readStatm().first; }
+
+void ResidentSetGovernor::run() {
+    std::unique_lock lock(m_mutex);
+    auto wait = kInterval;
+    while (!m_wake.wait_for(lock, wait, [&] { return m_stop; })) {
+        wait = kInterval;
+        const auto [resident, fileBacked] = readStatm();
+        if (resident <= m_limit) {
+            continue;
+        }
+        if (resident - fileBacked > m_limit) {
+            wait = kBackOff; // over the limit without a single file page: nothing to drop
+            continue;
+        }
+        lock.unlock();
+        m_drop();
+        m_drops.fetch_add(1, std::memory_order_relaxed);
+        lock.lock();
+    }
+}
+
+} // namespace omicron
