@@ -1,6 +1,8 @@
 #include "formats/oms_reader.hpp"
 
+#include "io/atomic_file_writer.hpp"
 #include "io/input_error.hpp"
+#include "sort/scratch_folder.hpp"
 
 #include <algorithm>
 #include <array>
@@ -80,7 +82,8 @@ bool isOmsFile(const std::string& path) {
     }
 }
 
-OmsReader::OmsReader(const std::string& path, PointStorage storage) : m_stream(path) {
+OmsReader::OmsReader(const std::string& path, PointStorage storage,
+                     std::uint64_t memoryBudgetBytes, const std::string& tempDir) : m_stream(path) {
     namespace h = oms::header;
     const auto error = [&](InputErrorKind kind, std::uint64_t byte, const std::string& detail) {
         return InputError(kind, path, InputLocation::byte(byte), detail);
@@ -259,8 +262,20 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage) : m_stream(p
     m_info.fileBytes = fileBytes;
     m_info.cube = CubeTransform{origin, edge};
     m_info.sourceOffset = sourceOffset;
-    m_cloud = std::make_shared<SortedCloud>(m_info.cube, sourceOffset, attributes,
-                                            static_cast<std::size_t>(pointCount),
+    const auto capacity = static_cast<std::size_t>(pointCount);
+    if (storage == PointStorage::Exact && memoryBudgetBytes > 0 &&
+        pointCount * SortedCloud::exactBytesPerPoint(attributes) > memoryBudgetBytes / 2) {
+        const std::string folder = tempDir.empty() ? ScratchFolder::defaultParent() : tempDir;
+        try {
+            m_cloud = std::make_shared<SortedCloud>(m_info.cube, sourceOffset, attributes,
+                                                    capacity, FileBacking{folder},
+                                                    memoryBudgetBytes);
+        } catch (const std::runtime_error& problem) {
+            throw OutputError(problem.what());
+        }
+        return;
+    }
+    m_cloud = std::make_shared<SortedCloud>(m_info.cube, sourceOffset, attributes, capacity,
                                             CloudOrder::Morton, storage);
 }
 

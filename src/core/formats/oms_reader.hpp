@@ -43,8 +43,12 @@ public:
     // count differs), UnsupportedFeature (another version, sort depth, attribute bit, or a
     // big-endian file), MalformedHeader (header checksum, record size, non-finite cube, reserved
     // bytes), NoPoints (count 0).
-    // `storage` is how cloud() keeps positions and colours.
-    explicit OmsReader(const std::string& path, PointStorage storage = PointStorage::Exact);
+    // `storage` is how cloud() keeps positions and colours. With a `memoryBudgetBytes`, an
+    // exact cloud larger than half of it lives in an unnamed scratch file under `tempDir`
+    // (empty: $TMPDIR or /tmp), kept out of memory beyond the budget (SortedCloud's
+    // FileBacking); no room there is an OutputError naming the folder.
+    explicit OmsReader(const std::string& path, PointStorage storage = PointStorage::Exact,
+                       std::uint64_t memoryBudgetBytes = 0, const std::string& tempDir = {});
 
     const OmsInfo& info() const { return m_info; }
     std::shared_ptr<SortedCloud> cloud() const { return m_cloud; }

@@ -324,7 +324,11 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
 PipelineResult BuildPipeline::runSortedStream(const std::string& path,
                                               const PipelineOptions& options) {
     beginRun(BuildPhase::Opening);
-    OmsReader reader(path, options.storage);
+    // A sorted stream larger than the budget streams into a file-backed cloud.
+    OmsReader reader(path, options.storage,
+                     options.memoryBudgetBytes > 0 ? options.memoryBudgetBytes
+                                                   : defaultMemoryBudget(),
+                     options.tempDir);
     const OmsInfo& info = reader.info();
     PipelineResult result;
     result.pipeline = toString(PipelineKind::SortedStream);

@@ -34,13 +34,6 @@ std::uint64_t batchBytesPerPoint(AttributeSet attributes) {
 // block and what the stages after the sort keep.
 constexpr std::uint64_t kMinRunPoints = 4096;
 
-// Bytes a point takes in an exact sorted cloud.
-std::uint64_t exactBytesPerPoint(AttributeSet attributes) {
-    return sizeof(glm::vec3) + (attributes.has(Attribute::Normal) ? sizeof(glm::vec3) : 0) +
-           (attributes.has(Attribute::Color) ? sizeof(glm::u8vec3) : 0) +
-           (attributes.has(Attribute::Intensity) ? sizeof(std::uint16_t) : 0);
-}
-
 } // namespace
 
 std::uint64_t IncrementalMortonSorter::inMemoryBytes(const CloudInfo& info) {
@@ -73,7 +66,7 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
             info.pointCount);
     }
     if (spills && m_options.storage == PointStorage::Exact &&
-        info.pointCount * exactBytesPerPoint(info.attributes) > budget / 2) {
+        info.pointCount * SortedCloud::exactBytesPerPoint(info.attributes) > budget / 2) {
         // Even sorted, the points would take more than half the budget: the cloud goes to a
         // scratch file, and its pages leave memory whenever the process exceeds the budget.
         const std::string folder =

@@ -3,6 +3,7 @@
 // adversarial shapes and the generated scene, with the invariants checked after every pass;
 // the runs are gone after the build and after a cancel.
 #include "hierarchy_test_support.hpp"
+#include "formats/oms_writer.hpp"
 #include "io/ply/ply_writer.hpp"
 #include "memory_budget.hpp"
 #include "pipeline/build_pipeline.hpp"
@@ -123,6 +124,25 @@ TEST(BudgetedBuild, GeneratedSceneSpillsTheSame) {
     EXPECT_EQ(test::fingerprint(*spilled.hierarchy(), false),
               test::fingerprint(*inMemory.hierarchy(), false));
     EXPECT_EQ(entriesIn(scratch.path()), 0u);
+}
+
+// Pipeline 2 beyond the budget: a sorted stream whose points exceed half of it streams into
+// a file-backed cloud, and the hierarchy is the in-memory one.
+TEST(BudgetedBuild, ASortedStreamBeyondTheBudgetStreamsIntoAFileBackedCloud) {
+    OMICRON_REQUIRE_SHARED_FILE(path, "lion.ply");
+    test::TempDir scratch;
+    const std::string oms = scratch.file("lion.oms");
+    {
+        BuildPipeline sorter;
+        sorter.run(path, options(0, scratch.path().string()));
+        writeOms(oms, *sorter.sortedCloud(), sorter.sortedCloud()->sortedEnd());
+    }
+    const Built inMemory = build(oms, options(0, scratch.path().string()), true);
+    EXPECT_FALSE(inMemory.fileBacked);
+    const Built budgeted = build(oms, options(kMinMemoryBudget, scratch.path().string()), true);
+    EXPECT_TRUE(budgeted.fileBacked);
+    EXPECT_EQ(budgeted.print, inMemory.print);
+    EXPECT_EQ(entriesIn(scratch.path()), 1u) << "only the .oms: the cloud's file has no name";
 }
 
 // Cancelled while the runs are merged into the builder: the run returns cancelled, and the
