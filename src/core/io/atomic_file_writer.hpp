@@ -41,6 +41,8 @@ public:
 
 private:
     void flushBuffer();
+    // Large files: written windows leave the page cache (see the .cpp).
+    void dropBehind();
     [[noreturn]] void fail(const std::string& what, int error);
 
     std::string m_targetPath;
@@ -49,6 +51,8 @@ private:
     std::vector<char> m_buffer;
     std::size_t m_buffered = 0;
     std::uint64_t m_bytesWritten = 0;
+    std::uint64_t m_onFile = 0;      // bytes handed to write(2)
+    std::uint64_t m_windowStart = 0; // the oldest window still in the page cache
     bool m_committed = false;
 };
 
