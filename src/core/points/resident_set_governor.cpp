@@ -1,5 +1,6 @@
 #include "points/resident_set_governor.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <unistd.h>
@@ -8,11 +9,13 @@ namespace omicron {
 
 namespace {
 
-// How often the resident set is looked at, and how long to wait while the process's own
-// (anonymous) memory is over the limit alone: dropping file pages then would only make the
-// cloud's readers fault for nothing.
+// How often the resident set is looked at, and how long to wait while what is over the limit is
+// hardly file pages: dropping them then would only make the cloud's readers fault for nothing.
 constexpr auto kInterval = std::chrono::milliseconds(2);
 constexpr auto kBackOff = std::chrono::milliseconds(250);
+// File-backed resident bytes below which a drop is not worth it (the program's own code and
+// libraries count there too).
+constexpr std::uint64_t kMinDroppable = std::uint64_t{64} << 20;
 
 } // namespace
 
@@ -56,8 +59,8 @@ void ResidentSetGovernor::run() {
         if (resident <= m_limit) {
             continue;
         }
-        if (resident - fileBacked > m_limit) {
-            wait = kBackOff; // over the limit without a single file page: nothing to drop
+        if (fileBacked < std::min<std::uint64_t>(m_limit / 8, kMinDroppable)) {
+            wait = kBackOff; // over the limit, but hardly by file pages: nothing worth dropping
             continue;
         }
         lock.unlock();

@@ -7,6 +7,7 @@
 #include "front/front.hpp"
 #include "front/front_projection.hpp"
 #include "hierarchy_test_support.hpp"
+#include "memory_budget.hpp"
 #include "test_files.hpp"
 
 #include <atomic>
@@ -324,6 +325,10 @@ struct ConcurrentCase {
     double cpuBudgetMs;
     std::size_t pointBudget;
     LeafCollapse collapse;
+    // Sorted under the smallest memory budget: runs on disk and the sorted points in a
+    // scratch file whose pages the governor drops every few milliseconds while the front
+    // and the builder read them.
+    bool fileBacked = false;
 };
 
 void PrintTo(const ConcurrentCase& value, std::ostream* out) { *out << value.name; }
@@ -335,11 +340,17 @@ class FrontConcurrency : public testing::TestWithParam<ConcurrentCase> {};
 TEST_P(FrontConcurrency, InvariantsHoldAndSettledLeavesAreSubstitutedWhileBuilding) {
     const ConcurrentCase& param = GetParam();
     const int maxLevel = 7;
-    const auto cloud = makeCloud(Shape::Random, 120000, 31);
+    const auto cloud = makeCloud(Shape::Random, param.fileBacked ? 300000 : 120000, 31);
     SortOptions sortOptions;
     sortOptions.batchPoints = 1500;
     sortOptions.chunks = 32;
+    test::TempDir scratch;
+    if (param.fileBacked) {
+        sortOptions.memoryBudgetBytes = kMinMemoryBudget;
+        sortOptions.tempDir = scratch.path().string();
+    }
     IncrementalMortonSorter sorter(cloud.info, sortOptions);
+    ASSERT_EQ(sorter.cloud()->fileBacked(), param.fileBacked);
     sorter.add(cloud.points);
     BuildOptions options = frontBuildOptions(maxLevel, param.collapse);
     options.checkInvariants = false; // a fast builder: more states for the front to see
@@ -435,6 +446,9 @@ TEST_P(FrontConcurrency, InvariantsHoldAndSettledLeavesAreSubstitutedWhileBuildi
     producer.join();
     builder.wait();
     EXPECT_TRUE(sorted.load());
+    if (param.fileBacked) {
+        EXPECT_GT(sorter.cloud()->residentDrops(), 0u) << "the governor never dropped a page";
+    }
     EXPECT_GT(evaluationsDuringBuild, 5u) << "the front never evaluated while building";
     EXPECT_GT(substituted, 0u);
     EXPECT_GT(readySince.size(), 0u);
@@ -461,7 +475,9 @@ INSTANTIATE_TEST_SUITE_P(
     Builds, FrontConcurrency,
     testing::Values(ConcurrentCase{"WholeSweeps", 0.0, 0, LeafCollapse::Lossless},
                     ConcurrentCase{"SegmentedWithBudget", 0.2, 30000, LeafCollapse::Paper},
-                    ConcurrentCase{"NoCollapse", 0.0, 50000, LeafCollapse::Off}),
+                    ConcurrentCase{"NoCollapse", 0.0, 50000, LeafCollapse::Off},
+                    ConcurrentCase{"FileBackedUnderTheSmallestBudget", 0.2, 50000,
+                                   LeafCollapse::Lossless, true}),
     [](const testing::TestParamInfo<ConcurrentCase>& info) { return info.param.name; });
 
 } // namespace
