@@ -14,7 +14,7 @@
 //   is drawable), overview_ms, view_full_detail_ms_median/_max (camera stop -> full detail),
 //   loads, evictions, read_mb, resident_mb, budget_mb, rss_after_open_mb,
 //   rss_after_overview_mb, rss_end_mb (/proc/self/statm) and peak_rss_mb (getrusage).
-// Run it once per configuration: the peak RSS is the process's. bench/paged_omh.sh makes a
+// Run it once per configuration: the peak RSS is the process's. bench/out_of_core.sh makes a
 // large .omh from a real scan and runs every configuration.
 #include "bench_timing.hpp"
 #include "formats/omh_reader.hpp"
