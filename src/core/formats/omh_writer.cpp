@@ -110,6 +110,7 @@ private:
         m_level = level;
         m_batchBegin = begin;
         m_batchEnd = end;
+        readAhead(level, begin, end, points);
         m_batch.resize(end - begin);
         tbb::parallel_for(begin, end, [&](std::size_t i) {
             m_hierarchy.nodeSplats(m_hierarchy.node(level, i), m_batch[i - begin],
@@ -117,6 +118,28 @@ private:
         });
     }
 
+    // A cloud in a scratch file (beyond the memory budget) is read through page faults, one
+    // page each (no fault-around there): where the batch's held points are dense in what its
+    // nodes cover (leaves, and parents down to a pick every few pages), the covered range is
+    // read ahead in bulk first, so the faults find the page cache. Sparse top levels are left
+    // to their faults: reading everything they cover would cost more.
+    void readAhead(int level, std::size_t begin, std::size_t end, std::size_t heldPoints) const {
+        const SortedCloud& cloud = m_hierarchy.cloud();
+        if (!cloud.fileBacked()) {
+            return;
+        }
+        const OctreeNode& first = m_hierarchy.node(level, begin);
+        const OctreeNode& last = m_hierarchy.node(level, end - 1);
+        const std::size_t coveredBegin = first.coveredBegin;
+        const std::size_t coveredEnd = std::size_t{last.coveredBegin} + last.coveredCount;
+        if (heldPoints * kDenseStridePoints >= coveredEnd - coveredBegin) {
+            cloud.willRead(coveredBegin, coveredEnd);
+        }
+    }
+
+    // At most this many covered points per held one for a read-ahead (a pick every two pages
+    // of 12-byte positions).
+    static constexpr std::size_t kDenseStridePoints = 680;
     static constexpr std::size_t kBatchPoints = std::size_t{1} << 20;
     const Hierarchy& m_hierarchy;
     tbb::enumerable_thread_specific<SplatScratch> m_scratch;

@@ -13,6 +13,7 @@
 // into 2 MiB resident, and releasing part of one splits it (points/resident_pages.hpp).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -95,6 +96,16 @@ public:
     operator std::span<const T>() const { return {m_data.get(), m_size}; }
 
     bool fileBacked() const { return m_mappedBytes != 0; }
+    // File-backed only: elements [begin, end) will be read soon; the kernel starts reading
+    // them into the page cache (they are not mapped: the resident set does not grow).
+    void willRead(std::size_t begin, std::size_t end) const {
+        if (m_mappedBytes != 0 && begin < end) {
+            const std::uintptr_t base = reinterpret_cast<std::uintptr_t>(m_data.get());
+            const std::uintptr_t first = (base + begin * sizeof(T)) & ~std::uintptr_t{4095};
+            const std::uintptr_t last = base + std::min(end, m_size) * sizeof(T);
+            madvise(reinterpret_cast<void*>(first), last - first, MADV_WILLNEED);
+        }
+    }
     // File-backed only: the array's pages leave the resident set (any thread; readers and
     // writers may go on: a page they touch next is faulted back in with its data).
     void dropResident() const {

@@ -122,6 +122,16 @@ std::size_t SortedCloud::bytesResident() const {
            (m_packed ? m_packed->bytesResident() : 0);
 }
 
+void SortedCloud::willRead(std::size_t begin, std::size_t end) const {
+    if (!fileBacked()) {
+        return;
+    }
+    m_positions.willRead(begin, end);
+    m_normals.willRead(begin, end);
+    m_colors.willRead(begin, end);
+    m_intensities.willRead(begin, end);
+}
+
 std::uint64_t SortedCloud::residentDrops() const {
     return m_governor ? m_governor->drops() : 0;
 }

@@ -148,6 +148,9 @@ public:
     bool pagedOnDemand() const { return m_pages == PageSize::Small; }
     // Its arrays are in a scratch file, kept out of memory beyond the budget.
     bool fileBacked() const { return m_governor != nullptr; }
+    // File-backed: points [begin, end) will be read soon (a writer's next batch): their pages
+    // are read ahead into the page cache, without a fault each. No-op for other clouds.
+    void willRead(std::size_t begin, std::size_t end) const;
     // File-backed: how often the arrays' pages were dropped to stay within the budget.
     std::uint64_t residentDrops() const;
 
