@@ -29,7 +29,7 @@ trap 'rm -rf "$work"' EXIT
 source bench/measure.sh
 
 # Bytes a finished process wrote (its "File system outputs", 512-byte blocks).
-written_bytes() { awk -F': ' '/File system outputs/ { print $2 * 512 }' "$work/time.txt"; }
+written_bytes() { awk -F': ' '/File system outputs/ { printf "%.0f\n", $2 * 512 }' "$work/time.txt"; }
 
 read -r wall _ _ rss < <(measure "$cli" tile "$source_cloud" "$work/big.ply" --copies "$copies")
 points=$("$cli" info "$work/big.ply" | awk '/^points:/ { print $2 }')
@@ -40,7 +40,7 @@ echo "bench=out_of_core step=read budget=none bytes=$bytes wall_s=$wall"
 
 configs=()
 # An in-memory build keeps about 45 bytes a point at its peak.
-half_bytes=$(awk '/MemTotal/ { print $2 * 512 }' /proc/meminfo)
+half_bytes=$(awk '/MemTotal/ { printf "%.0f\n", $2 * 512 }' /proc/meminfo)
 [ $((points * 45)) -lt "$half_bytes" ] && configs=(none)
 configs+=("${budgets[@]}")
 for budget in "${configs[@]}"; do
