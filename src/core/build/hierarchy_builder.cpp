@@ -307,6 +307,8 @@ void HierarchyBuilder::insertInput(std::size_t available, bool inputEnded) {
     Worker& worker = *m_worker;
     std::vector<LeafRun>& runs = worker.runs;
     runs.clear();
+    // A cloud in a scratch file: what the last pass read may leave memory before this one.
+    m_cloud->keepWithinBudget();
     const std::size_t end = m_cloud->visitPositions([&](const auto& positions) {
         const std::size_t cut = insertableEnd(positions, m_insertedEnd, available, inputEnded,
                                               groupLevel, kMaxInsertPoints);

@@ -101,9 +101,22 @@ public:
 private:
     void fill(int level, std::size_t begin) {
         const std::size_t nodes = m_hierarchy.nodeCount(level);
-        // Batches of about kBatchPoints held points keep memory bounded.
+        // Batches of about kBatchPoints held points keep memory bounded. Over a cloud in a
+        // scratch file, a batch also covers at most an eighth of the budget's worth of its
+        // points: the pages it reads stay mapped until the check between batches.
+        const SortedCloud& cloud = m_hierarchy.cloud();
+        const std::uint64_t maxCovered =
+            cloud.fileBacked()
+                ? cloud.residentBudget() / 8 / SortedCloud::exactBytesPerPoint(cloud.attributes())
+                : UINT64_MAX;
+        const std::size_t coveredBegin = m_hierarchy.node(level, begin).coveredBegin;
         std::size_t end = begin, points = 0;
-        while (end < nodes && (end == begin || points < kBatchPoints)) {
+        while (end < nodes &&
+               (end == begin ||
+                (points < kBatchPoints &&
+                 std::size_t{m_hierarchy.node(level, end).coveredBegin} +
+                         m_hierarchy.node(level, end).coveredCount - coveredBegin <=
+                     maxCovered))) {
             points += m_hierarchy.node(level, end).pointCount;
             ++end;
         }
@@ -128,6 +141,7 @@ private:
         if (!cloud.fileBacked()) {
             return;
         }
+        cloud.keepWithinBudget(); // what the previous batch read may go first
         const OctreeNode& first = m_hierarchy.node(level, begin);
         const OctreeNode& last = m_hierarchy.node(level, end - 1);
         const std::size_t coveredBegin = first.coveredBegin;

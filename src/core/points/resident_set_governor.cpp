@@ -50,23 +50,29 @@ std::pair<std::uint64_t, std::uint64_t> readStatm() {
 
 std::uint64_t ResidentSetGovernor::residentBytes() { return readStatm().first; }
 
+ResidentSetGovernor::Look ResidentSetGovernor::look() {
+    const auto [resident, fileBacked] = readStatm();
+    if (resident <= m_limit) {
+        return Look::Under;
+    }
+    if (fileBacked < std::min<std::uint64_t>(m_limit / 8, kMinDroppable)) {
+        return Look::NothingToDrop; // over the limit, but hardly by file pages
+    }
+    m_drop(); // two threads dropping at once is harmless: the pages are just unmapped
+    m_drops.fetch_add(1, std::memory_order_relaxed);
+    return Look::Dropped;
+}
+
+bool ResidentSetGovernor::checkNow() { return look() == Look::Dropped; }
+
 void ResidentSetGovernor::run() {
     std::unique_lock lock(m_mutex);
     auto wait = kInterval;
     while (!m_wake.wait_for(lock, wait, [&] { return m_stop; })) {
-        wait = kInterval;
-        const auto [resident, fileBacked] = readStatm();
-        if (resident <= m_limit) {
-            continue;
-        }
-        if (fileBacked < std::min<std::uint64_t>(m_limit / 8, kMinDroppable)) {
-            wait = kBackOff; // over the limit, but hardly by file pages: nothing worth dropping
-            continue;
-        }
         lock.unlock();
-        m_drop();
-        m_drops.fetch_add(1, std::memory_order_relaxed);
+        const Look result = look();
         lock.lock();
+        wait = result == Look::NothingToDrop ? kBackOff : kInterval;
     }
 }
 

@@ -28,6 +28,11 @@ public:
     ResidentSetGovernor& operator=(const ResidentSetGovernor&) = delete;
 
     std::uint64_t limitBytes() const { return m_limit; }
+    // One look now, on the calling thread, as the thread does it: for the loops that touch
+    // the most pages (a merge filling the cloud, a save reading it), which should not depend
+    // on the thread being scheduled in time on a busy machine. Any thread. True when it
+    // dropped.
+    bool checkNow();
     std::uint64_t drops() const { return m_drops.load(std::memory_order_relaxed); }
 
     // The process's resident set now, in bytes (0 where /proc is not mounted).
@@ -35,6 +40,8 @@ public:
 
 private:
     void run();
+    enum class Look { Under, NothingToDrop, Dropped };
+    Look look();
 
     std::uint64_t m_limit;
     std::function<void()> m_drop;

@@ -106,6 +106,9 @@ void SortedCloud::publish(std::size_t newSortedEnd) {
         }
     }
     m_sortedEnd.store(newSortedEnd, std::memory_order_release);
+    // A merge or a stream fills a file-backed cloud faster than the governor's thread may
+    // be scheduled on a busy machine: look after every published range too.
+    keepWithinBudget();
 }
 
 void SortedCloud::markComplete() {

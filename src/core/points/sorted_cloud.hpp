@@ -151,6 +151,15 @@ public:
     // File-backed: points [begin, end) will be read soon (a writer's next batch): their pages
     // are read ahead into the page cache, without a fault each. No-op for other clouds.
     void willRead(std::size_t begin, std::size_t end) const;
+    // File-backed: drops the arrays' pages now if the process is over the budget (the loops
+    // that touch the most pages call it between batches; publish() does). No-op otherwise.
+    void keepWithinBudget() const {
+        if (m_governor) {
+            m_governor->checkNow();
+        }
+    }
+    // File-backed: the budget its governor keeps the process within (0 for other clouds).
+    std::uint64_t residentBudget() const { return m_governor ? m_governor->limitBytes() : 0; }
     // File-backed: how often the arrays' pages were dropped to stay within the budget.
     std::uint64_t residentDrops() const;
 
