@@ -355,7 +355,9 @@ void TestMainWindowGL::hierarchyTreeSelectionHighlightsTheNodeInTheView() {
     QAbstractItemModelTester tester(panel->hierarchyModel(),
                                     QAbstractItemModelTester::FailureReportingMode::QtTest);
     QSignalSpy finished(window.service(), &BuilderService::buildFinished);
-    window.openDefaultScene(1'000'000);
+    // Long enough to be drawn while it builds, also on a busy machine (the delay chart below
+    // needs a leaf drawn during the build).
+    window.openDefaultScene(3'000'000);
     QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 1, kBuildTimeoutMs);
     QTRY_VERIFY(!window.service()->busy());
     QTRY_COMPARE(panel->hierarchyModel()->rowCount(), 1);
