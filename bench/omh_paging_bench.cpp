@@ -21,6 +21,7 @@
 #include "formats/omh_writer.hpp"
 #include "pipeline/build_pipeline.hpp"
 #include "front/front.hpp"
+#include "front/front_settle.hpp"
 #include "memory_budget.hpp"
 
 #include <algorithm>
@@ -46,18 +47,8 @@ double peakRssMb() {
     return static_cast<double>(usage.ru_maxrss) / 1024.0;
 }
 
-// Resident now (/proc/self/statm), to tell the phases apart; the peak is getrusage's.
-double currentRssMb() {
-    std::FILE* file = std::fopen("/proc/self/statm", "r");
-    long pages = 0, resident = 0;
-    if (file != nullptr) {
-        if (std::fscanf(file, "%ld %ld", &pages, &resident) != 2) {
-            resident = 0;
-        }
-        std::fclose(file);
-    }
-    return static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE)) / (1 << 20);
-}
+// Resident now, to tell the phases apart; the peak is getrusage's.
+double currentRssMb() { return static_cast<double>(processResidentSet().bytes) / (1 << 20); }
 
 double rawReadMs(const std::string& path) {
     const auto start = Clock::now();
@@ -83,36 +74,11 @@ FrontCamera orthographic(double cx, double cy, double half, double widthPx) {
     return camera;
 }
 
-// Evaluates once a millisecond (a fast frame rate) until three evaluations in a row change
-// nothing with no load outstanding; returns the seconds it took.
-double settle(Front& front, const Hierarchy& hierarchy, const FrontCamera& camera,
-              const FrontOptions& options) {
-    const NodeResidency* residency = hierarchy.residency();
-    const auto pending = [&] { return residency ? residency->stats().pendingLoads : 0; };
+// Seconds until the front changes nothing with no load outstanding (settleFront).
+double settle(Front& front, const FrontCamera& camera, const FrontOptions& options) {
     const auto start = Clock::now();
-    for (int quiet = 0; quiet < 3 && secondsSince(start) < 600.0;) {
-        const std::uint64_t before = pending();
-        const FrontEvaluation result = front.evaluate(camera, options);
-        const bool changed =
-            result.branched + result.pruned + result.substituted + result.placeholdersInserted > 0;
-        quiet = !changed && result.finishedSweep && before == 0 && pending() == 0 ? quiet + 1 : 0;
-        if (!changed) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        }
-    }
+    settleFront(front, camera, options, SettleLimits{INT_MAX, 600.0});
     return secondsSince(start);
-}
-
-bool parseSize(const std::string& text, std::uint64_t& bytes) {
-    char* end = nullptr;
-    const double value = std::strtod(text.c_str(), &end);
-    const std::string unit(end);
-    const double scale = unit == "G" ? 1024.0 * 1024 * 1024 : unit == "M" ? 1024.0 * 1024 : -1.0;
-    if (value <= 0.0 || scale < 0.0) {
-        return false;
-    }
-    bytes = static_cast<std::uint64_t>(value * scale);
-    return true;
 }
 
 } // namespace
@@ -131,8 +97,8 @@ int main(int argc, char** argv) {
         const std::string arg = argv[i];
         if (arg == "--whole") {
             whole = true;
-        } else if (arg == "--budget" && i + 1 < argc && parseSize(argv[i + 1], budget)) {
-            ++i;
+        } else if (arg == "--budget" && i + 1 < argc && parseByteSize(argv[i + 1])) {
+            budget = *parseByteSize(argv[++i]);
         } else if (arg == "--views" && i + 1 < argc) {
             views = std::max(1, std::atoi(argv[++i]));
         } else if (arg == "--width" && i + 1 < argc) {
@@ -188,7 +154,7 @@ int main(int argc, char** argv) {
             }
         }
         const double firstPixelsMs = secondsSince(start) * 1e3;
-        const double overviewMs = settle(front, *hierarchy, overview, options) * 1e3;
+        const double overviewMs = settle(front, overview, options) * 1e3;
         const double overviewRssMb = currentRssMb();
 
         // Close-ups on a grid over the cloud's footprint, a twentieth of the cube wide.
@@ -198,7 +164,7 @@ int main(int argc, char** argv) {
             const double cx = (0.5 + v % side) / side;
             const double cy = (0.5 + v / side) / side;
             detailMs.push_back(
-                settle(front, *hierarchy, orthographic(cx, cy, 0.025, widthPx), options) * 1e3);
+                settle(front, orthographic(cx, cy, 0.025, widthPx), options) * 1e3);
         }
         std::sort(detailMs.begin(), detailMs.end());
 

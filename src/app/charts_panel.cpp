@@ -1,6 +1,6 @@
 #include "charts_panel.hpp"
 
-#include "process_memory.hpp"
+#include "memory_budget.hpp"
 #include "time_series_chart.hpp"
 
 #include <QGridLayout>
@@ -161,7 +161,7 @@ void ChartsPanel::sample() {
         m_cpu->append(1, now, m_frontMs);
         m_fpsChart->append(0, now, m_lastFps);
     }
-    m_memory->append(0, now, static_cast<double>(residentBytes()) / 1048576.0);
+    m_memory->append(0, now, static_cast<double>(processResidentSet().bytes) / 1048576.0);
     m_memory->append(1, now, static_cast<double>(m_hierarchyBytes) / 1048576.0);
     if (m_memoryBudgetBytes > 0) {
         m_memory->setLine(2, {QPointF(0.0, static_cast<double>(m_memoryBudgetBytes) / 1048576.0),

@@ -5,7 +5,7 @@
 #include "charts_panel.hpp"
 #include "cloud_view.hpp"
 #include "cut_panel.hpp"
-#include "process_memory.hpp"
+#include "memory_budget.hpp"
 #include "ui_mainwindow.h"
 
 #include <QActionGroup>
@@ -497,14 +497,14 @@ void MainWindow::updateStatus() {
                             : tr("idle"));
     // A .omh beyond the memory budget: its points come and go with the view.
     const FrameStats& frame = m_lastFrameStats;
+    const QString resident = mib(processResidentSet().bytes);
     m_memoryLabel->setText(
         frame.pagedPoints
             ? tr("%1 (points paged: %2 of %3%4)")
-                  .arg(mib(residentBytes()), mib(frame.pagedResidentBytes),
-                       mib(frame.pagedBudgetBytes),
+                  .arg(resident, mib(frame.pagedResidentBytes), mib(frame.pagedBudgetBytes),
                        frame.pendingLoads > 0 ? tr(", %1 nodes loading").arg(frame.pendingLoads)
                                               : QString())
-            : mib(residentBytes()));
+            : resident);
 }
 
 void MainWindow::applyViewParameters(const ViewParameters& parameters) {

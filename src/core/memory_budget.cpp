@@ -68,6 +68,22 @@ std::uint64_t physicalMemoryBytes() {
     return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize);
 }
 
+ResidentSet processResidentSet() {
+    std::FILE* file = std::fopen("/proc/self/statm", "r");
+    if (file == nullptr) {
+        return {};
+    }
+    unsigned long long pages = 0, resident = 0, shared = 0;
+    const int fields = std::fscanf(file, "%llu %llu %llu", &pages, &resident, &shared);
+    std::fclose(file);
+    const long pageBytes = ::sysconf(_SC_PAGESIZE);
+    if (fields != 3 || pageBytes <= 0) {
+        return {};
+    }
+    const auto page = static_cast<std::uint64_t>(pageBytes);
+    return {resident * page, shared * page};
+}
+
 std::uint64_t defaultMemoryBudget() {
     const std::uint64_t physical = physicalMemoryBytes();
     return physical == 0 ? 4 * kGiB : physical / 2;

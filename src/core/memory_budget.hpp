@@ -25,6 +25,14 @@ std::string formatByteSize(std::uint64_t bytes);
 // The machine's physical memory (sysconf), or 0 when it cannot be told.
 std::uint64_t physicalMemoryBytes();
 
+// This process's resident set (Linux: /proc/self/statm), in bytes, and the part of it that
+// is file-backed pages (which can be dropped and read again); zeros where it cannot be read.
+struct ResidentSet {
+    std::uint64_t bytes = 0;
+    std::uint64_t fileBackedBytes = 0;
+};
+ResidentSet processResidentSet();
+
 // The default budget: half of physical memory (4 GiB when it cannot be told), so small clouds
 // never spill and a big one leaves the rest of the machine usable.
 std::uint64_t defaultMemoryBudget();

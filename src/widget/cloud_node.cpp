@@ -2,12 +2,12 @@
 
 #include "build/hierarchy.hpp"
 #include "front/front_projection.hpp"
+#include "front/front_settle.hpp"
 #include "shader_library.hpp"
 #include "view_camera.hpp"
 
 #include <QElapsedTimer>
 #include <QOpenGLContext>
-#include <QThread>
 #include <algorithm>
 #include <cmath>
 #include <glm/gtc/type_ptr.hpp>
@@ -26,10 +26,8 @@ constexpr float kSplatDepthOffsetRadii = 1.0f;
 constexpr std::size_t kPackBatchBytes = std::size_t{8} << 20;
 // Screenshots: most front evaluations spent converging before the image is taken.
 constexpr int kMaxSettleEvaluations = 256;
-// Screenshots of a hierarchy paged in on demand: evaluations in a row that must change nothing
-// with no load outstanding, and the most time spent waiting for loads.
-constexpr int kQuietSettleEvaluations = 3;
-constexpr qint64 kMaxPagedSettleMs = 120000;
+// Screenshots of a hierarchy paged in on demand: the most time spent waiting for loads.
+constexpr double kMaxPagedSettleSeconds = 120.0;
 
 glm::vec3 levelColor(int level) {
     // Hues spaced by the golden angle: neighbouring levels never look alike.
@@ -181,44 +179,21 @@ void CloudNode::evaluateFront(RenderContext& context) {
     options.pointBudget = settings.pointBudget;
     options.cpuBudgetMs = context.settle ? 0.0 : settings.frontBudgetMs;
 
-    NodeResidency* residency = m_hierarchy->residency();
-    const auto pendingLoads = [&]() -> std::uint64_t {
-        return residency != nullptr ? residency->stats().pendingLoads : 0;
-    };
+    const NodeResidency* residency = m_hierarchy->residency();
     QElapsedTimer timer;
     timer.start();
-    int evaluations = 0;
-    int quietEvaluations = 0;
     std::uint64_t pendingBefore = 0;
-    while (true) {
-        // Loads that finish during an evaluation are only seen by the next one.
-        pendingBefore = pendingLoads();
-        const FrontEvaluation evaluation = m_front->evaluate(camera, options);
-        ++evaluations;
-        const bool changed = evaluation.placeholdersInserted + evaluation.substituted +
-                                 evaluation.branched + evaluation.pruned >
-                             0;
-        if (!context.settle) {
-            break;
-        }
-        if (residency == nullptr) {
-            if ((!changed && evaluation.finishedSweep) || evaluations >= kMaxSettleEvaluations) {
-                break;
-            }
-            continue;
-        }
-        // Paged points: a screenshot waits for the nodes its front asks for, until a few
-        // evaluations in a row change nothing with no load outstanding (or the time limit).
-        const bool quiet = !changed && evaluation.finishedSweep && pendingBefore == 0 &&
-                           pendingLoads() == 0;
-        quietEvaluations = quiet ? quietEvaluations + 1 : 0;
-        if (quietEvaluations == kQuietSettleEvaluations ||
-            timer.elapsed() > kMaxPagedSettleMs) {
-            break;
-        }
-        if (!changed) {
-            QThread::msleep(1); // the loader is reading
-        }
+    if (!context.settle) {
+        // Loads that finish during the evaluation are only seen by the next one.
+        pendingBefore = residency != nullptr ? residency->stats().pendingLoads : 0;
+        m_front->evaluate(camera, options);
+    } else {
+        // A screenshot: everything the threshold asks for; paged points, the nodes too.
+        pendingBefore = settleFront(*m_front, camera, options,
+                                    residency != nullptr
+                                        ? SettleLimits{INT_MAX, kMaxPagedSettleSeconds}
+                                        : SettleLimits{kMaxSettleEvaluations})
+                            .pendingBefore;
     }
     if (residency != nullptr) {
         const ResidencyStats paged = residency->stats();

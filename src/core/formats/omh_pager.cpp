@@ -16,19 +16,16 @@ constexpr double kEvictTo = 0.875;
 } // namespace
 
 std::uint64_t OmhPager::residentBytesPerPoint(const omh::Header& header) {
-    std::uint64_t bytes = sizeof(glm::vec3) + sizeof(std::uint16_t); // position, radius
-    bytes += header.attributes.has(Attribute::Normal) ? sizeof(glm::vec3) : 0;
-    bytes += header.attributes.has(Attribute::Color) ? sizeof(glm::u8vec3) : 0;
-    bytes += header.attributes.has(Attribute::Intensity) ? sizeof(std::uint16_t) : 0;
-    bytes += header.estimatedNormals ? sizeof(std::uint32_t) : 0;
-    return bytes;
+    // The cloud's point, then the stored splat radius and estimated normal.
+    return pointBytes(header.attributes) + sizeof(std::uint16_t) +
+           (header.estimatedNormals ? sizeof(std::uint32_t) : 0);
 }
 
 OmhPager::OmhPager(const omh::Header& header, std::shared_ptr<SortedCloud> cloud,
                    Hierarchy& hierarchy, std::uint64_t budgetBytes)
     : m_header(header), m_bytesPerPoint(residentBytesPerPoint(header)), m_budget(budgetBytes),
       m_cloud(std::move(cloud)), m_hierarchy(hierarchy), m_stream(header.path),
-      m_decoder(header, *m_cloud, hierarchy.mutableStoredSplats()),
+      m_decoder(m_header, *m_cloud, hierarchy.mutableStoredSplats()),
       m_state(std::make_unique<std::atomic<std::uint8_t>[]>(header.totalNodes)),
       m_wantedFrame(header.totalNodes, 0),
       m_lastUsed(header.totalNodes, 0) {
@@ -68,7 +65,7 @@ bool OmhPager::resident(int level, std::uint32_t index) const {
 
 bool OmhPager::want(int level, std::uint32_t index, double priority) {
     const std::uint64_t id = nodeId(level, index);
-    const std::uint32_t frame = m_frame.load(std::memory_order_relaxed);
+    const std::uint32_t frame = m_frame;
     m_lastUsed[id] = frame;
     std::uint8_t state = m_state[id].load(std::memory_order_acquire);
     if (state == Resident) {
@@ -91,7 +88,7 @@ bool OmhPager::want(int level, std::uint32_t index, double priority) {
 
 void OmhPager::hold(int level, std::uint32_t index) {
     const std::uint64_t id = nodeId(level, index);
-    m_lastUsed[id] = m_frame.load(std::memory_order_relaxed);
+    m_lastUsed[id] = m_frame;
     m_heldBytes += std::uint64_t{m_hierarchy.node(level, index).pointCount} * m_bytesPerPoint;
 }
 
@@ -116,7 +113,7 @@ void OmhPager::publishRequests(std::uint32_t frame) {
 }
 
 void OmhPager::endFrame() {
-    const std::uint32_t frame = m_frame.load(std::memory_order_relaxed);
+    const std::uint32_t frame = m_frame;
     publishRequests(frame);
     {
         std::lock_guard lock(m_mutex);
@@ -125,39 +122,26 @@ void OmhPager::endFrame() {
         m_newlyResident.clear();
     }
     if (m_residentBytes.load(std::memory_order_relaxed) > m_budget) {
-        // Least recently used first among the nodes this frame neither held nor wanted.
-        std::vector<std::size_t> order;
-        for (std::size_t i = 0; i < m_residentList.size(); ++i) {
-            const NodeRef& node = m_residentList[i];
-            if (m_lastUsed[nodeId(node.level, node.index)] < frame) {
-                order.push_back(i);
-            }
-        }
-        std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-            const NodeRef& x = m_residentList[a];
-            const NodeRef& y = m_residentList[b];
-            return m_lastUsed[nodeId(x.level, x.index)] < m_lastUsed[nodeId(y.level, y.index)];
-        });
+        // The nodes this frame neither held nor wanted, least recently used first.
+        const auto lastUsed = [&](const NodeRef& node) {
+            return m_lastUsed[nodeId(node.level, node.index)];
+        };
+        const auto unused = std::partition(m_residentList.begin(), m_residentList.end(),
+                                           [&](const NodeRef& node) { return lastUsed(node) >= frame; });
+        std::sort(unused, m_residentList.end(),
+                  [&](const NodeRef& a, const NodeRef& b) { return lastUsed(a) < lastUsed(b); });
         const auto target = static_cast<std::uint64_t>(static_cast<double>(m_budget) * kEvictTo);
-        std::vector<bool> evicted(m_residentList.size(), false);
-        for (std::size_t i : order) {
-            if (m_residentBytes.load(std::memory_order_relaxed) <= target) {
-                break;
-            }
-            evict(m_residentList[i].level, m_residentList[i].index);
-            evicted[i] = true;
+        auto kept = unused;
+        for (; kept != m_residentList.end() &&
+               m_residentBytes.load(std::memory_order_relaxed) > target;
+             ++kept) {
+            evict(kept->level, kept->index);
         }
-        std::size_t kept = 0;
-        for (std::size_t i = 0; i < m_residentList.size(); ++i) {
-            if (!evicted[i]) {
-                m_residentList[kept++] = m_residentList[i];
-            }
-        }
-        m_residentList.resize(kept);
+        m_residentList.erase(unused, kept);
     }
     m_lastHeldBytes.store(m_heldBytes, std::memory_order_relaxed);
     m_heldBytes = 0;
-    m_frame.store(frame + 1, std::memory_order_relaxed);
+    m_frame = frame + 1;
 }
 
 void OmhPager::evict(int level, std::uint32_t index) {
@@ -208,11 +192,8 @@ void OmhPager::load(int level, std::uint32_t index) {
         m_stream.readExact(m_records.data(), m_records.size(), section);
         const std::size_t bad = m_decoder.store(m_records.data(), count, begin, node.code, level);
         if (bad != count) {
-            throw InputError(InputErrorKind::MalformedValue, m_header.path,
-                             InputLocation::byte(offset + bad * m_header.recordBytes),
-                             "in " + section + ", record " +
-                                 std::to_string(begin + bad - m_levelFirst[static_cast<std::size_t>(level)]) +
-                                 ": the position lies outside the cell of its node");
+            throw m_decoder.misplaced(level, begin + bad - m_levelFirst[static_cast<std::size_t>(level)],
+                                      node.code);
         }
     } catch (const InputError& error) {
         m_pages.release(begin, begin + count);

@@ -102,9 +102,9 @@ private:
         int level = 0;
         std::uint32_t index = 0;
     };
-    std::vector<NodeRef> m_residentList; // render thread's view of the resident nodes
+    std::vector<NodeRef> m_residentList; // render thread's view of the resident nodes (any order)
     std::vector<Request> m_frameRequests; // render thread: the Queued nodes this frame asked for
-    std::atomic<std::uint32_t> m_frame{1};
+    std::uint32_t m_frame = 1; // render thread
     std::uint64_t m_heldBytes = 0; // render thread, this frame
     std::atomic<std::uint64_t> m_lastHeldBytes{0};
 

@@ -521,11 +521,7 @@ void OmhReader::readPoints(int level, const std::vector<OctreeNode>& nodes,
                 decoder.store(m_block.data() + r * recordBytes, run,
                               static_cast<std::size_t>(firstPoint + inLevel), node.code, level);
             if (bad != run && !firstProblem) {
-                firstProblem.emplace(
-                    InputErrorKind::MalformedValue, m_header.path,
-                    InputLocation::byte(entry.payloadOffset + (inLevel + bad) * recordBytes),
-                    "in " + section + ", record " + std::to_string(inLevel + bad) +
-                        ": the position lies outside the cell of its node " + hex(node.code));
+                firstProblem = decoder.misplaced(level, inLevel + bad, node.code);
             }
             r += run;
         }

@@ -1,6 +1,9 @@
 #include "formats/omh_record_decoder.hpp"
 
+#include "formats/omh_reader.hpp"
+
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 namespace omicron {
@@ -17,7 +20,7 @@ template <typename T> T loadLe(const std::uint8_t* at) {
 
 OmhRecordDecoder::OmhRecordDecoder(const omh::Header& header, SortedCloud& cloud,
                                    StoredSplats& splats)
-    : m_layout(omh::RecordLayout::of(header.attributes, header.estimatedNormals)),
+    : m_header(header), m_layout(omh::RecordLayout::of(header.attributes, header.estimatedNormals)),
       m_attributes(header.attributes), m_estimatedNormals(header.estimatedNormals),
       m_cloud(cloud), m_splats(splats) {}
 
@@ -51,6 +54,18 @@ std::size_t OmhRecordDecoder::store(const std::uint8_t* records, std::size_t cou
                                 : 0u);
     }
     return firstBad;
+}
+
+InputError OmhRecordDecoder::misplaced(int level, std::uint64_t recordInLevel,
+                                       morton::Code nodeCode) const {
+    const std::uint64_t byte =
+        m_header.levels[static_cast<std::size_t>(level)].payloadOffset + recordInLevel * m_layout.bytes;
+    char code[19];
+    std::snprintf(code, sizeof(code), "0x%016llx", static_cast<unsigned long long>(nodeCode));
+    return InputError(InputErrorKind::MalformedValue, m_header.path, InputLocation::byte(byte),
+                      "in " + omhSectionAt(m_header, byte) + ", record " +
+                          std::to_string(recordInLevel) +
+                          ": the position lies outside the cell of its node " + code);
 }
 
 } // namespace omicron

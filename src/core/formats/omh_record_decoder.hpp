@@ -5,6 +5,7 @@
 
 #include "build/stored_splats.hpp"
 #include "formats/omh_format.hpp"
+#include "io/input_error.hpp"
 #include "points/morton.hpp"
 #include "points/sorted_cloud.hpp"
 
@@ -26,7 +27,12 @@ public:
 
     std::size_t recordBytes() const { return m_layout.bytes; }
 
+    // The error for record `recordInLevel` of `level` that store() found outside the cell of
+    // its node `nodeCode`, naming the file, the byte and the section: both loaders' words.
+    InputError misplaced(int level, std::uint64_t recordInLevel, morton::Code nodeCode) const;
+
 private:
+    const omh::Header& m_header; // outlives the decoder
     omh::RecordLayout m_layout;
     AttributeSet m_attributes;
     bool m_estimatedNormals;

@@ -105,25 +105,26 @@ private:
         // scratch file, a batch also covers at most an eighth of the budget's worth of its
         // points: the pages it reads stay mapped until the check between batches.
         const SortedCloud& cloud = m_hierarchy.cloud();
+        cloud.keepWithinBudget(); // what the previous batch read may go first
         const std::uint64_t maxCovered =
             cloud.fileBacked()
-                ? cloud.residentBudget() / 8 / SortedCloud::exactBytesPerPoint(cloud.attributes())
+                ? cloud.residentBudget() / 8 / pointBytes(cloud.attributes())
                 : UINT64_MAX;
         const std::size_t coveredBegin = m_hierarchy.node(level, begin).coveredBegin;
+        const auto coveredEnd = [&](std::size_t i) { // of nodes [begin, i]
+            const OctreeNode& node = m_hierarchy.node(level, i);
+            return std::size_t{node.coveredBegin} + node.coveredCount;
+        };
         std::size_t end = begin, points = 0;
-        while (end < nodes &&
-               (end == begin ||
-                (points < kBatchPoints &&
-                 std::size_t{m_hierarchy.node(level, end).coveredBegin} +
-                         m_hierarchy.node(level, end).coveredCount - coveredBegin <=
-                     maxCovered))) {
+        while (end < nodes && (end == begin || (points < kBatchPoints &&
+                                                coveredEnd(end) - coveredBegin <= maxCovered))) {
             points += m_hierarchy.node(level, end).pointCount;
             ++end;
         }
         m_level = level;
         m_batchBegin = begin;
         m_batchEnd = end;
-        readAhead(level, begin, end, points);
+        readAhead(coveredBegin, coveredEnd(end - 1), points);
         m_batch.resize(end - begin);
         tbb::parallel_for(begin, end, [&](std::size_t i) {
             m_hierarchy.nodeSplats(m_hierarchy.node(level, i), m_batch[i - begin],
@@ -136,18 +137,9 @@ private:
     // nodes cover (leaves, and parents down to a pick every few pages), the covered range is
     // read ahead in bulk first, so the faults find the page cache. Sparse top levels are left
     // to their faults: reading everything they cover would cost more.
-    void readAhead(int level, std::size_t begin, std::size_t end, std::size_t heldPoints) const {
-        const SortedCloud& cloud = m_hierarchy.cloud();
-        if (!cloud.fileBacked()) {
-            return;
-        }
-        cloud.keepWithinBudget(); // what the previous batch read may go first
-        const OctreeNode& first = m_hierarchy.node(level, begin);
-        const OctreeNode& last = m_hierarchy.node(level, end - 1);
-        const std::size_t coveredBegin = first.coveredBegin;
-        const std::size_t coveredEnd = std::size_t{last.coveredBegin} + last.coveredCount;
+    void readAhead(std::size_t coveredBegin, std::size_t coveredEnd, std::size_t heldPoints) const {
         if (heldPoints * kDenseStridePoints >= coveredEnd - coveredBegin) {
-            cloud.willRead(coveredBegin, coveredEnd);
+            m_hierarchy.cloud().willRead(coveredBegin, coveredEnd); // no-op unless file-backed
         }
     }
 

@@ -1,8 +1,7 @@
 #include "formats/oms_reader.hpp"
 
-#include "io/atomic_file_writer.hpp"
 #include "io/input_error.hpp"
-#include "sort/scratch_folder.hpp"
+#include "sort/budgeted_cloud.hpp"
 
 #include <algorithm>
 #include <array>
@@ -262,21 +261,9 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage,
     m_info.fileBytes = fileBytes;
     m_info.cube = CubeTransform{origin, edge};
     m_info.sourceOffset = sourceOffset;
-    const auto capacity = static_cast<std::size_t>(pointCount);
-    if (storage == PointStorage::Exact && memoryBudgetBytes > 0 &&
-        pointCount * SortedCloud::exactBytesPerPoint(attributes) > memoryBudgetBytes / 2) {
-        const std::string folder = tempDir.empty() ? ScratchFolder::defaultParent() : tempDir;
-        try {
-            m_cloud = std::make_shared<SortedCloud>(m_info.cube, sourceOffset, attributes,
-                                                    capacity, FileBacking{folder},
-                                                    memoryBudgetBytes);
-        } catch (const std::runtime_error& problem) {
-            throw OutputError(problem.what());
-        }
-        return;
-    }
-    m_cloud = std::make_shared<SortedCloud>(m_info.cube, sourceOffset, attributes, capacity,
-                                            CloudOrder::Morton, storage);
+    m_cloud = makeSortedCloud(m_info.cube, sourceOffset, attributes,
+                              static_cast<std::size_t>(pointCount), storage, memoryBudgetBytes,
+                              tempDir);
 }
 
 ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptions& options) {

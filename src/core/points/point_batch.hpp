@@ -38,6 +38,14 @@ private:
     std::uint8_t m_bits = 0;
 };
 
+// Bytes of one point with `attributes` as the point model keeps it: position, then normal,
+// colour and intensity where present (a PointBatch, an exact SortedCloud).
+constexpr std::size_t pointBytes(AttributeSet attributes) {
+    return sizeof(glm::vec3) + (attributes.has(Attribute::Normal) ? sizeof(glm::vec3) : 0) +
+           (attributes.has(Attribute::Color) ? sizeof(glm::u8vec3) : 0) +
+           (attributes.has(Attribute::Intensity) ? sizeof(std::uint16_t) : 0);
+}
+
 struct PointBatch {
     AttributeSet attributes; // which optional vectors below are filled (one entry per point)
     std::vector<glm::vec3> positions; // unit cube

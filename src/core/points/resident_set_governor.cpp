@@ -1,9 +1,9 @@
 #include "points/resident_set_governor.hpp"
 
+#include "memory_budget.hpp"
+
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
-#include <unistd.h>
 
 namespace omicron {
 
@@ -31,31 +31,13 @@ ResidentSetGovernor::~ResidentSetGovernor() {
     m_thread.join();
 }
 
-namespace {
-
-// Resident and file-backed resident bytes from /proc/self/statm (zeros where unreadable).
-std::pair<std::uint64_t, std::uint64_t> readStatm() {
-    std::FILE* file = std::fopen("/proc/self/statm", "r");
-    if (file == nullptr) {
-        return {0, 0};
-    }
-    unsigned long long pages = 0, resident = 0, shared = 0;
-    const int read = std::fscanf(file, "%llu %llu %llu", &pages, &resident, &shared);
-    std::fclose(file);
-    const auto page = static_cast<std::uint64_t>(sysconf(_SC_PAGESIZE));
-    return read == 3 ? std::pair{resident * page, shared * page} : std::pair{0ull, 0ull};
-}
-
-} // namespace
-
-std::uint64_t ResidentSetGovernor::residentBytes() { return readStatm().first; }
 
 ResidentSetGovernor::Look ResidentSetGovernor::look() {
-    const auto [resident, fileBacked] = readStatm();
-    if (resident <= m_limit) {
+    const ResidentSet resident = processResidentSet();
+    if (resident.bytes <= m_limit) {
         return Look::Under;
     }
-    if (fileBacked < std::min<std::uint64_t>(m_limit / 8, kMinDroppable)) {
+    if (resident.fileBackedBytes < std::min<std::uint64_t>(m_limit / 8, kMinDroppable)) {
         return Look::NothingToDrop; // over the limit, but hardly by file pages
     }
     m_drop(); // two threads dropping at once is harmless: the pages are just unmapped

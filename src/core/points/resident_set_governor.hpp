@@ -35,9 +35,6 @@ public:
     bool checkNow();
     std::uint64_t drops() const { return m_drops.load(std::memory_order_relaxed); }
 
-    // The process's resident set now, in bytes (0 where /proc is not mounted).
-    static std::uint64_t residentBytes();
-
 private:
     void run();
     enum class Look { Under, NothingToDrop, Dropped };

@@ -60,12 +60,6 @@ SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffs
 
 SortedCloud::~SortedCloud() = default;
 
-std::uint64_t SortedCloud::exactBytesPerPoint(AttributeSet attributes) {
-    return sizeof(glm::vec3) + (attributes.has(Attribute::Normal) ? sizeof(glm::vec3) : 0) +
-           (attributes.has(Attribute::Color) ? sizeof(glm::u8vec3) : 0) +
-           (attributes.has(Attribute::Intensity) ? sizeof(std::uint16_t) : 0);
-}
-
 SortedCloud::StagedRange SortedCloud::stage(std::size_t end) {
     const std::size_t begin = m_sortedEnd.load(std::memory_order_relaxed);
     assert(begin <= end && end <= m_capacity);

@@ -74,10 +74,6 @@ public:
                 std::size_t capacity, const FileBacking& backing, std::uint64_t budgetBytes);
     ~SortedCloud();
 
-    // Bytes a point takes in an exact cloud with `attributes` (position, normal, colour,
-    // intensity): what a file-backed cloud keeps in its scratch file.
-    static std::uint64_t exactBytesPerPoint(AttributeSet attributes);
-
     SortedCloud(const SortedCloud&) = delete;
     SortedCloud& operator=(const SortedCloud&) = delete;
 

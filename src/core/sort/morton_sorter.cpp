@@ -1,10 +1,9 @@
 #include "sort/morton_sorter.hpp"
 
-#include "io/atomic_file_writer.hpp"
 #include "memory_budget.hpp"
+#include "sort/budgeted_cloud.hpp"
 #include "sort/radix_sort.hpp"
 #include "sort/run_merger.hpp"
-#include "sort/scratch_folder.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -23,13 +22,6 @@ double secondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Bytes of one point in a PointBatch with these attributes.
-std::uint64_t batchBytesPerPoint(AttributeSet attributes) {
-    return sizeof(glm::vec3) + (attributes.has(Attribute::Normal) ? sizeof(glm::vec3) : 0) +
-           (attributes.has(Attribute::Color) ? sizeof(glm::u8vec3) : 0) +
-           (attributes.has(Attribute::Intensity) ? sizeof(std::uint16_t) : 0);
-}
-
 // Runs are sized from half the budget; the rest covers the merge's read buffers, the write
 // block and what the stages after the sort keep.
 constexpr std::uint64_t kMinRunPoints = 4096;
@@ -38,7 +30,7 @@ constexpr std::uint64_t kMinRunPoints = 4096;
 
 std::uint64_t IncrementalMortonSorter::inMemoryBytes(const CloudInfo& info) {
     // Input in arrival order + bin code and index + the sorted cloud's copy + chunk scratch.
-    const std::uint64_t perPoint = 2 * batchBytesPerPoint(info.attributes) +
+    const std::uint64_t perPoint = 2 * pointBytes(info.attributes) +
                                    sizeof(morton::Code) + sizeof(std::uint32_t) + 1;
     return info.pointCount * perPoint;
 }
@@ -65,23 +57,10 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
             static_cast<std::size_t>(std::min<std::uint64_t>(runPoints, capacity)),
             info.pointCount);
     }
-    if (spills && m_options.storage == PointStorage::Exact &&
-        info.pointCount * SortedCloud::exactBytesPerPoint(info.attributes) > budget / 2) {
-        // Even sorted, the points would take more than half the budget: the cloud goes to a
-        // scratch file, and its pages leave memory whenever the process exceeds the budget.
-        const std::string folder =
-            m_options.tempDir.empty() ? ScratchFolder::defaultParent() : m_options.tempDir;
-        try {
-            m_cloud = std::make_shared<SortedCloud>(info.cube, info.sourceOffset, info.attributes,
-                                                    capacity, FileBacking{folder}, budget);
-        } catch (const std::runtime_error& error) {
-            throw OutputError(error.what());
-        }
-    } else {
-        m_cloud =
-            std::make_shared<SortedCloud>(info.cube, info.sourceOffset, info.attributes, capacity,
-                                          CloudOrder::Morton, m_options.storage);
-    }
+    // Even sorted, points beyond half the budget go to a scratch file (such a sort always
+    // spills: its in-memory peak is over twice the cloud).
+    m_cloud = makeSortedCloud(info.cube, info.sourceOffset, info.attributes, capacity,
+                              m_options.storage, budget, m_options.tempDir);
     m_input.attributes = info.attributes;
     if (spills) {
         return;

@@ -15,25 +15,11 @@ namespace {
 // Records are encoded into blocks of this size before each write.
 constexpr std::size_t kWriteBlockBytes = std::size_t{4} << 20;
 
-std::size_t batchBytesPerPoint(AttributeSet attributes) {
-    std::size_t bytes = sizeof(glm::vec3);
-    if (attributes.has(Attribute::Normal)) {
-        bytes += sizeof(glm::vec3);
-    }
-    if (attributes.has(Attribute::Color)) {
-        bytes += sizeof(glm::u8vec3);
-    }
-    if (attributes.has(Attribute::Intensity)) {
-        bytes += sizeof(std::uint16_t);
-    }
-    return bytes;
-}
-
 } // namespace
 
 std::size_t RunSpiller::bytesPerBufferedPoint(AttributeSet attributes) {
     // code, then the sort's key + index and their scratch copies.
-    return batchBytesPerPoint(attributes) + sizeof(morton::Code) +
+    return pointBytes(attributes) + sizeof(morton::Code) +
            2 * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
 }
 

@@ -7,22 +7,19 @@
 #include "formats/omh_reader.hpp"
 #include "formats/omh_writer.hpp"
 #include "front/front.hpp"
+#include "front/front_settle.hpp"
 #include "hierarchy_test_support.hpp"
 #include "pipeline/build_pipeline.hpp"
 #include "test_files.hpp"
 
-#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <gtest/gtest.h>
 #include <sys/mman.h>
-#include <thread>
 #include <unistd.h>
 
 namespace omicron::test {
 namespace {
-
-using namespace std::chrono_literals;
 
 std::string saveBuilt(const TempDir& dir, const SyntheticCloud& cloud, int depth) {
     const BuildResult built = buildSynthetic(cloud, checkedOptions(depth, LeafCollapse::Off));
@@ -96,33 +93,17 @@ void expectFrontPointsEqual(const Front& front, const Hierarchy& paged, const Hi
     }
 }
 
-// Evaluates until nothing changes and no load is pending, checking the invariants after every
-// call; returns the calls made.
-int settlePaged(Front& front, const Hierarchy& hierarchy, const FrontCamera& camera,
-                const FrontOptions& options) {
-    const auto deadline = std::chrono::steady_clock::now() + 60s;
-    int quiet = 0;
-    for (int call = 1; std::chrono::steady_clock::now() < deadline; ++call) {
-        // Loads finished before the evaluation were seen by it; one that finishes after it
-        // would be missed by a check after it alone.
-        const std::uint64_t pendingBefore = hierarchy.residency()->stats().pendingLoads;
-        const FrontEvaluation result = front.evaluate(camera, options);
-        EXPECT_EQ(front.checkInvariants(), "");
-        const bool changed = result.branched + result.pruned + result.substituted +
-                                 result.placeholdersInserted >
-                             0;
-        const bool still = !changed && result.finishedSweep && pendingBefore == 0 &&
-                           hierarchy.residency()->stats().pendingLoads == 0;
-        quiet = still ? quiet + 1 : 0;
-        if (quiet == 3) {
-            return call;
-        }
-        if (!changed) {
-            std::this_thread::sleep_for(200us); // the loader is reading
-        }
+// Evaluates until nothing changes and no load is pending (settleFront), checking the invariants
+// after every call; returns the calls made.
+int settlePaged(Front& front, const FrontCamera& camera, const FrontOptions& options) {
+    const SettleResult result =
+        settleFront(front, camera, options, SettleLimits{INT_MAX, 60.0},
+                    [&] { EXPECT_EQ(front.checkInvariants(), ""); });
+    if (!result.settled) {
+        ADD_FAILURE() << "the paged front did not settle in 60 s";
+        return 0;
     }
-    ADD_FAILURE() << "the paged front did not settle in 60 s";
-    return 0;
+    return result.evaluations;
 }
 
 std::size_t leafCount(const Hierarchy& hierarchy) {
@@ -165,7 +146,7 @@ TEST(OmhPagedLoad, NodesOnlyAtOpenThenEveryLeafOnDemandEqualToTheWholeLoad) {
     Front front(paged);
     const FrontEvaluation first = front.evaluate(lookingAt({0.5, 0.5, 0.5}, 0.5, 1e9), fullDetail());
     EXPECT_EQ(first.frontSize, 0u) << "the root is drawn only once its points are in memory";
-    settlePaged(front, *paged, lookingAt({0.5, 0.5, 0.5}, 0.5, 1e9), fullDetail());
+    settlePaged(front, lookingAt({0.5, 0.5, 0.5}, 0.5, 1e9), fullDetail());
     EXPECT_EQ(front.entries().size(), leafCount(*paged));
     expectFrontPointsEqual(front, *paged, *whole);
     const ResidencyStats stats = paged->residency()->stats();
@@ -197,7 +178,7 @@ TEST(OmhPagedLoad, ATinyBudgetEvictsAndReloadsAndNeverDrawsAMissingNode) {
     const FrontCamera cornerB = lookingAt({0.9, 0.9, 0.5}, 0.08, 1e9);
     std::uint64_t loadsBefore = 0;
     for (const FrontCamera* camera : {&cornerA, &cornerB, &cornerA}) {
-        settlePaged(front, *paged, *camera, fullDetail());
+        settlePaged(front, *camera, fullDetail());
         expectFrontPointsEqual(front, *paged, *whole);
         // One more frame so that eviction has seen the settled front.
         front.evaluate(*camera, fullDetail());
@@ -231,7 +212,7 @@ TEST(OmhPagedLoad, UnderAPointBudgetOnlyWhatTheBudgetDrawsIsRead) {
     options.pointBudget = 10000;
     // Full detail is asked everywhere, the budget allows a twelfth of it: the front settles
     // at the budget and reads about what it draws, not every node it would like to refine.
-    settlePaged(front, *paged, lookingAt({0.5, 0.5, 0.5}, 0.5, 1e9), options);
+    settlePaged(front, lookingAt({0.5, 0.5, 0.5}, 0.5, 1e9), options);
     std::uint64_t drawn = 0;
     for (const FrontEntry& entry : front.entries()) {
         drawn += paged->node(entry.level(), entry.index).pointCount;
@@ -260,7 +241,7 @@ TEST(OmhPagedLoad, AFrontMovingEveryFrameKeepsItsInvariantsWhileTheLoaderReads) 
     // However far the loader lagged behind (it may not even have run yet), the last view
     // fills in once the camera stops.
     const FrontCamera last = lookingAt({1.0, 0.0, 0.5}, 0.25, 1e6);
-    settlePaged(front, *paged, last, fullDetail());
+    settlePaged(front, last, fullDetail());
     expectFrontPointsEqual(front, *paged, *whole);
     EXPECT_GT(paged->residency()->stats().loads, 0u);
 }
@@ -275,7 +256,7 @@ TEST(OmhPagedLoad, UnreadableRecordsFailTheirNodeOnlyAndTheParentStaysDrawn) {
     const omh::Header& header = reader.header();
     std::filesystem::resize_file(path, header.levels.back().payloadOffset);
     Front front(paged);
-    settlePaged(front, *paged, lookingAt({0.5, 0.5, 0.5}, 0.5, 1e9), fullDetail());
+    settlePaged(front, lookingAt({0.5, 0.5, 0.5}, 0.5, 1e9), fullDetail());
     const ResidencyStats stats = paged->residency()->stats();
     EXPECT_GT(stats.failedNodes, 0u);
     EXPECT_NE(stats.firstError.find(path), std::string::npos) << stats.firstError;
@@ -296,14 +277,14 @@ TEST(OmhPagedLoad, SavingAPagedHierarchyWritesTheSameBytesAndReplacingItsOwnFile
     OmhReader reader(path);
     const auto paged = openPaged(reader, 4096);
     Front front(paged); // some nodes resident, most not: the save must not depend on it
-    settlePaged(front, *paged, lookingAt({0.2, 0.2, 0.5}, 0.1, 1e9), fullDetail());
+    settlePaged(front, lookingAt({0.2, 0.2, 0.5}, 0.1, 1e9), fullDetail());
     const std::string copy = dir.file("copy.omh");
     writeOmh(copy, *paged, reader.header().build);
     EXPECT_EQ(readBytes(copy), original);
     // Saving over the file it pages from: the pager keeps reading the old file's data.
     writeOmh(path, *paged, reader.header().build);
     EXPECT_EQ(readBytes(path), original);
-    settlePaged(front, *paged, lookingAt({0.8, 0.8, 0.5}, 0.1, 1e9), fullDetail());
+    settlePaged(front, lookingAt({0.8, 0.8, 0.5}, 0.1, 1e9), fullDetail());
     EXPECT_EQ(paged->residency()->stats().failedNodes, 0u);
     std::size_t files = 0;
     for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir.path())) {

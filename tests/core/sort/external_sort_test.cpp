@@ -89,6 +89,32 @@ std::string writeAdversarialCloud(const test::TempDir& dir, std::size_t count) {
 }
 
 // The smallest budget: every cloud here spills, into `scratch`.
+// Runs `run` with files limited to `limitBytes` (RLIMIT_FSIZE, SIGXFSZ ignored: a write beyond
+// it fails with EFBIG, as on a full disk) and returns the OutputError it threw ("" if none).
+std::string outputErrorUnderFileSizeLimit(rlim_t limitBytes, const std::function<void()>& run) {
+    rlimit previous{};
+    if (getrlimit(RLIMIT_FSIZE, &previous) != 0) {
+        ADD_FAILURE() << "getrlimit(RLIMIT_FSIZE) failed";
+        return {};
+    }
+    const auto previousHandler = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit limited = previous;
+    limited.rlim_cur = limitBytes;
+    std::string message;
+    if (setrlimit(RLIMIT_FSIZE, &limited) != 0) {
+        ADD_FAILURE() << "setrlimit(RLIMIT_FSIZE) failed";
+    } else {
+        try {
+            run();
+        } catch (const OutputError& error) {
+            message = error.what();
+        }
+    }
+    setrlimit(RLIMIT_FSIZE, &previous);
+    std::signal(SIGXFSZ, previousHandler);
+    return message;
+}
+
 SortOptions spillingOptions(const test::TempDir& scratch) {
     SortOptions options;
     options.memoryBudgetBytes = kMinMemoryBudget;
@@ -262,20 +288,9 @@ TEST(ExternalSortCleanup, AFullDiskIsAClearErrorAndLeavesNothing) {
     auto reader = openPointCloud(path);
     const std::uint64_t needed =
         reader->info().pointCount * PointRecordLayout::of(reader->info().attributes).bytes;
-    rlimit previous{};
-    ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &previous), 0);
-    const auto previousHandler = std::signal(SIGXFSZ, SIG_IGN);
-    rlimit limited = previous;
-    limited.rlim_cur = 256 * 1024; // a run is larger than this
-    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limited), 0);
-    std::string message;
-    try {
+    const std::string message = outputErrorUnderFileSizeLimit(256 * 1024, [&] { // < a run
         sortPointCloud(*reader, spilling, [](const SortedCloud&, std::size_t, std::size_t) {});
-    } catch (const OutputError& error) {
-        message = error.what();
-    }
-    setrlimit(RLIMIT_FSIZE, &previous);
-    std::signal(SIGXFSZ, previousHandler);
+    });
     ASSERT_FALSE(message.empty()) << "the sort ignored a failed write";
     EXPECT_EQ(message.rfind(scratch.path().string() + ": cannot write the sorted run ", 0), 0u)
         << message;
@@ -296,20 +311,10 @@ TEST(ExternalSortCleanup, NoRoomForTheFileBackedCloudIsAClearErrorUpFront) {
     const std::string path = writeAdversarialCloud(dir, 300'000);
     const SortOptions spilling = spillingOptions(scratch);
     auto reader = openPointCloud(path);
-    rlimit previous{};
-    ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &previous), 0);
-    const auto previousHandler = std::signal(SIGXFSZ, SIG_IGN);
-    rlimit limited = previous;
-    limited.rlim_cur = 1024 * 1024; // less than the cloud's 300,000 x 15 bytes
-    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limited), 0);
-    std::string message;
-    try {
+    // Less than the cloud's 300,000 x 15 bytes.
+    const std::string message = outputErrorUnderFileSizeLimit(1024 * 1024, [&] {
         IncrementalMortonSorter sorter(reader->info(), spilling);
-    } catch (const OutputError& error) {
-        message = error.what();
-    }
-    setrlimit(RLIMIT_FSIZE, &previous);
-    std::signal(SIGXFSZ, previousHandler);
+    });
     ASSERT_FALSE(message.empty()) << "the sorter did not reserve the cloud's space";
     EXPECT_EQ(message.rfind(scratch.path().string() + ": cannot keep ", 0), 0u) << message;
     EXPECT_NE(message.find("sorted points beyond the memory budget"), std::string::npos) << message;
