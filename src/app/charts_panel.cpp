@@ -3,52 +3,121 @@
 #include "memory_budget.hpp"
 #include "time_series_chart.hpp"
 
+#include <QComboBox>
 #include <QGridLayout>
+#include <QHBoxLayout>
+#include <QLabel>
 #include <QLineSeries>
+#include <QVBoxLayout>
 #include <algorithm>
 
 namespace omicron {
 
 ChartsPanel::ChartsPanel(QWidget* parent) : QWidget(parent) {
-    auto* grid = new QGridLayout(this);
-    grid->setContentsMargins(2, 2, 2, 2);
+    auto* column = new QVBoxLayout(this);
+    column->setContentsMargins(2, 2, 2, 2);
+    column->setSpacing(2);
+    auto* controls = new QHBoxLayout();
+    controls->addWidget(new QLabel(tr("Time axis:"), this));
+    m_timeWindow = new QComboBox(this);
+    m_timeWindow->setObjectName(QStringLiteral("timeWindow"));
+    m_timeWindow->setToolTip(tr("All charts share this time axis (seconds since the open): "
+                                "the whole history, or a window that follows the last seconds"));
+    m_timeWindow->addItem(tr("Full history"), 0.0);
+    for (const int seconds : {10, 30, 60, 300}) {
+        m_timeWindow->addItem(seconds < 60 ? tr("Follow last %1 s").arg(seconds)
+                                           : tr("Follow last %1 min").arg(seconds / 60),
+                              static_cast<double>(seconds));
+    }
+    connect(m_timeWindow, &QComboBox::currentIndexChanged, this, [this](int index) {
+        setFollowSeconds(m_timeWindow->itemData(index).toDouble());
+    });
+    controls->addWidget(m_timeWindow);
+    controls->addStretch(1);
+    column->addLayout(controls);
+    auto* grid = new QGridLayout();
     grid->setSpacing(2);
-    const auto add = [&](const QString& title, const QString& unit, const QStringList& lines) {
-        auto* chart = new TimeSeriesChart(title, unit, lines, this);
+    column->addLayout(grid, 1);
+    const auto add = [&](const QString& title, const QString& unit, ChartUnit scale,
+                         const QStringList& lines) {
+        auto* chart = new TimeSeriesChart(title, unit, scale, lines, this);
         connect(chart, &TimeSeriesChart::exportFailed, this, &ChartsPanel::exportFailed);
         const int index = static_cast<int>(m_charts.size());
         grid->addWidget(chart, index / 3, index % 3);
         m_charts.push_back(chart);
         return chart;
     };
-    m_inserted = add(tr("Inserted points"), tr("points"),
-                     {tr("inserted"), tr("sorted"), tr("ideal (constant rate)")});
-    m_delay = add(tr("Insertion delay"), tr("ms"),
-                  {tr("leaf -> drawn median"), tr("leaf -> drawn max"), tr("sorted -> inserted")});
+    // Line names stay short so legends fit a small panel; the tooltips say what they mean.
+    m_inserted = add(tr("Inserted points"), tr("points"), ChartUnit::Count,
+                     {tr("inserted"), tr("sorted"), tr("ideal")});
+    m_delay = add(tr("Insertion delay"), tr("ms"), ChartUnit::Milliseconds,
+                  {tr("median"), tr("max"), tr("sort wait")});
     // Leaves are first drawn in bursts while a build runs: mark every sample, a lone one too.
     for (int line = 0; line < m_delay->lineCount(); ++line) {
         m_delay->line(line)->setPointsVisible(true);
     }
-    m_front = add(tr("Front size"), tr("nodes"), {tr("front nodes")});
-    m_cpu = add(tr("CPU per frame"), tr("ms"), {tr("total"), tr("front evaluation")});
-    m_fpsChart = add(tr("Frame rate"), tr("fps"), {tr("fps")});
-    m_memory = add(tr("Memory"), tr("MiB"),
-                   {tr("process resident"), tr("hierarchy + cloud"), tr("budget")});
+    m_front = add(tr("Front size"), tr("nodes"), ChartUnit::Count, {tr("front nodes")});
+    m_cpu = add(tr("CPU per frame"), tr("ms"), ChartUnit::Milliseconds,
+                {tr("total"), tr("front")});
+    m_fpsChart = add(tr("Frame rate"), tr("fps"), ChartUnit::Rate, {tr("fps")});
+    m_memory = add(tr("Memory"), tr("MiB"), ChartUnit::Mebibytes,
+                   {tr("resident"), tr("hierarchy"), tr("budget")});
     m_inserted->setToolTip(m_inserted->toolTip() +
-                           tr("\nThe ideal line is the straight line to the final point count: "
-                              "insertion at a constant rate."));
+                           tr("\ninserted: points inserted into the hierarchy.\nsorted: points "
+                              "the sorter has handed on.\nideal: the straight line to the final "
+                              "point count, insertion at a constant rate."));
     m_delay->setToolTip(
         m_delay->toolTip() +
-        tr("\nLeaf published -> drawn: the paper's front insertion delay, from the builder "
-           "publishing a leaf to the first frame of the view that draws its points (its own "
-           "node, or an ancestor standing for it); median and maximum over the leaves first "
-           "drawn since the previous sample.\nSorted -> inserted: how long ago the points now "
-           "inserted into the hierarchy had been sorted, the wait between the sorter and the "
-           "builder."));
+        tr("\nmedian / max: leaf published -> drawn, the paper's front insertion "
+           "delay, from the builder publishing a leaf to the first frame of the view that draws "
+           "its points (its own node, or an ancestor standing for it); median and maximum over "
+           "the leaves first drawn since the previous sample.\nsort wait: sorted -> inserted, "
+           "how long ago the points now inserted into the hierarchy had been sorted, the wait "
+           "between the sorter and the builder."));
+    m_cpu->setToolTip(m_cpu->toolTip() +
+                      tr("\ntotal: CPU time of the whole frame.\nfront: of which evaluating "
+                         "the render front."));
+    m_fpsChart->setToolTip(m_fpsChart->toolTip() +
+                           tr("\nFrames drawn in the last second, from the first frame on "
+                              "(the view draws on demand: 0 while nothing changes)."));
+    m_memory->setToolTip(m_memory->toolTip() +
+                         tr("\nresident: the process's resident memory.\nhierarchy: the "
+                            "hierarchy and the sorted cloud.\nbudget: the memory budget the "
+                            "build runs under, when one is set."));
     m_timer.setInterval(kSampleIntervalMs);
     connect(&m_timer, &QTimer::timeout, this, &ChartsPanel::sample);
     m_clock.start();
     m_timer.start();
+    setSharedTimeRange(0.0);
+}
+
+void ChartsPanel::setFollowSeconds(double seconds) {
+    m_followSeconds = std::max(0.0, seconds);
+    const int index = m_timeWindow->findData(m_followSeconds);
+    if (index >= 0 && index != m_timeWindow->currentIndex()) {
+        m_timeWindow->setCurrentIndex(index);
+    }
+    setSharedTimeRange(m_clock.nsecsElapsed() * 1e-9);
+}
+
+double ChartsPanel::frameRate() {
+    return m_frameRate.rateAt(m_clock.nsecsElapsed() * 1e-9);
+}
+
+void ChartsPanel::setSharedTimeRange(double now) {
+    double from = 0.0, to = 0.0;
+    if (m_followSeconds > 0.0) {
+        to = std::max(now, m_followSeconds);
+        from = to - m_followSeconds;
+    } else {
+        if (now > m_historyEnd) {
+            m_historyEnd = roundAxisEnd(now * 1.2, 6, ChartUnit::Seconds);
+        }
+        to = m_historyEnd;
+    }
+    for (TimeSeriesChart* chart : m_charts) {
+        chart->setTimeRange(from, to);
+    }
 }
 
 TimeSeriesChart* ChartsPanel::chart(const QString& title) const {
@@ -65,6 +134,10 @@ void ChartsPanel::startBuild() {
         chart->clear();
     }
     m_clock.restart();
+    m_historyEnd = 1.0;
+    m_frameRate.reset();
+    m_haveFrame = false;
+    setSharedTimeRange(0.0);
     m_progress = {};
     m_sortedHistory.clear();
     m_leafDelayMedians.clear();
@@ -86,9 +159,9 @@ void ChartsPanel::setMemoryBudget(std::uint64_t bytes) {
 
 void ChartsPanel::setFrame(const FrameStats& stats) {
     m_haveFrame = true;
+    m_frameRate.frameAt(m_clock.nsecsElapsed() * 1e-9);
     m_frameMs = stats.frameMs;
     m_frontMs = stats.frontMs;
-    m_lastFps = stats.fps;
     m_frontNodes = stats.frontNodes;
     if (stats.leavesFirstDrawn > 0) {
         m_leafDelayMedians.emplace_back(stats.leafDrawDelayMedianMs, stats.leavesFirstDrawn);
@@ -130,6 +203,7 @@ double ChartsPanel::insertionDelaySeconds(double now) const {
 
 void ChartsPanel::sample() {
     const double now = m_clock.nsecsElapsed() * 1e-9;
+    setSharedTimeRange(now);
     if (m_building) {
         m_inserted->append(0, now, static_cast<double>(m_progress.pointsInserted));
         m_inserted->append(1, now, static_cast<double>(m_progress.pointsSorted));
@@ -159,7 +233,7 @@ void ChartsPanel::sample() {
         m_front->append(0, now, static_cast<double>(m_frontNodes));
         m_cpu->append(0, now, m_frameMs);
         m_cpu->append(1, now, m_frontMs);
-        m_fpsChart->append(0, now, m_lastFps);
+        m_fpsChart->append(0, now, m_frameRate.rateAt(now));
     }
     m_memory->append(0, now, static_cast<double>(processResidentSet().bytes) / 1048576.0);
     m_memory->append(1, now, static_cast<double>(m_hierarchyBytes) / 1048576.0);

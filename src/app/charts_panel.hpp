@@ -3,9 +3,11 @@
 // constant-rate line, the insertion delays (the paper's front insertion delay, leaf published
 // -> first drawn, from the view's frames; and sorted -> inserted, from the build's progress),
 // the front size, CPU milliseconds per frame (front evaluation and total), frames per second,
-// and resident memory against the memory budget.
+// and resident memory against the memory budget. All charts share one time axis, seconds
+// since the open: the whole history, or a window following the last seconds.
 #pragma once
 
+#include "frame_rate_meter.hpp"
 #include "pipeline/build_pipeline.hpp"
 #include "render_settings.hpp"
 
@@ -14,6 +16,8 @@
 #include <QWidget>
 #include <deque>
 #include <vector>
+
+class QComboBox;
 
 namespace omicron {
 
@@ -28,6 +32,12 @@ public:
 
     const std::vector<TimeSeriesChart*>& charts() const { return m_charts; }
     TimeSeriesChart* chart(const QString& title) const;
+
+    // The time axis of every chart: 0 shows the whole history, N > 0 follows the last N s.
+    void setFollowSeconds(double seconds);
+    double followSeconds() const { return m_followSeconds; }
+    // Frames per second now, as the Frame rate chart draws it (FrameRateMeter).
+    double frameRate();
 
 public slots:
     // A new build: clears the build charts and restarts their clock.
@@ -46,6 +56,7 @@ signals:
 
 private:
     void sample();
+    void setSharedTimeRange(double now);
     double insertionDelaySeconds(double now) const;
     // Median (over the frames' medians, weighted by their leaf counts) and maximum of the
     // leaf -> drawn delays of the frames since the last sample; false when none drew a leaf.
@@ -59,6 +70,11 @@ private:
     TimeSeriesChart* m_fpsChart = nullptr;
     TimeSeriesChart* m_memory = nullptr;
 
+    QComboBox* m_timeWindow = nullptr;
+    double m_followSeconds = 0.0;
+    double m_historyEnd = 1.0; // the full-history axis only grows, in round steps
+    FrameRateMeter m_frameRate;
+
     QTimer m_timer;
     QElapsedTimer m_clock;
     PipelineProgress m_progress;
@@ -68,7 +84,6 @@ private:
     bool m_haveFrame = false;
     double m_frameMs = 0.0;
     double m_frontMs = 0.0;
-    double m_lastFps = 0.0;
     std::size_t m_frontNodes = 0;
     // (frame median ms, leaves first drawn) of the frames since the last sample, and their max.
     std::vector<std::pair<double, std::size_t>> m_leafDelayMedians;

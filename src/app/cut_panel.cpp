@@ -4,10 +4,16 @@
 #include "level_model.hpp"
 #include "ui_cutpanel.h"
 
+#include <QFontMetrics>
 #include <QHeaderView>
 #include <QItemSelectionModel>
+#include <QLayout>
 #include <QLocale>
+#include <QScrollBar>
+#include <QStyle>
+#include <QTableView>
 #include <QTreeView>
+#include <algorithm>
 
 namespace omicron {
 
@@ -48,6 +54,28 @@ CutPanel::~CutPanel() = default;
 
 QTreeView* CutPanel::hierarchyTree() const {
     return m_ui->hierarchyTree;
+}
+
+QTableView* CutPanel::levelTable() const {
+    return m_ui->levelTable;
+}
+
+int CutPanel::widthForAllLevelColumns() const {
+    // The widest number each column shows for a billion-point cloud (or its title, if wider).
+    static const char* const widest[LevelModel::ColumnCount] = {
+        "20", "99,999", "99,999,999", "99,999,999", "999,999,999", "99,999", "99,999", "999,999"};
+    const QTableView* table = m_ui->levelTable;
+    const QHeaderView* header = table->horizontalHeader();
+    const QFontMetrics cellFont(table->font());
+    int width = 0;
+    for (int column = 0; column < LevelModel::ColumnCount; ++column) {
+        const int cell = cellFont.horizontalAdvance(QString::fromLatin1(widest[column])) +
+                         2 * table->style()->pixelMetric(QStyle::PM_FocusFrameHMargin) + 8;
+        width += std::max(cell, header->sectionSizeHint(column));
+    }
+    width += 2 * table->frameWidth() + table->verticalScrollBar()->sizeHint().width();
+    const QMargins margins = layout()->contentsMargins();
+    return width + margins.left() + margins.right() + 24; // the group box and dock frames
 }
 
 QString CutPanel::nodeDetails() const {

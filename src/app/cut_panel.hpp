@@ -13,6 +13,7 @@
 #include <optional>
 #include <span>
 
+class QTableView;
 class QTreeView;
 
 namespace Ui {
@@ -33,6 +34,10 @@ public:
     LevelModel* levelModel() const { return m_levels; }
     HierarchyModel* hierarchyModel() const { return m_hierarchy; }
     QTreeView* hierarchyTree() const;
+    QTableView* levelTable() const;
+    // The panel width at which the level table shows all its columns with the numbers of a
+    // cloud of up to a billion points, for the window's first layout.
+    int widthForAllLevelColumns() const;
     // Thousandths of the code space of level `maxLevel` below `delimiter` (0..1000).
     static int sweptPermille(morton::Code delimiter, int maxLevel);
     // Bar values in thousandths, for tests: read, sorted, inserted, m_C.

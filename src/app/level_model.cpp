@@ -74,19 +74,19 @@ QVariant LevelModel::headerData(int section, Qt::Orientation orientation, int ro
         return {};
     }
     static const char* const titles[ColumnCount] = {
-        QT_TR_NOOP("Level"),       QT_TR_NOOP("Roots in L_C"), QT_TR_NOOP("Nodes"),
-        QT_TR_NOOP("Leaves"),      QT_TR_NOOP("Points"),       QT_TR_NOOP("Pending"),
-        QT_TR_NOOP("Substituted"), QT_TR_NOOP("Front nodes")};
+        // Short, so the table fits a side panel; the tooltips say the whole.
+        QT_TR_NOOP("Level"),  QT_TR_NOOP("Roots"),   QT_TR_NOOP("Nodes"),  QT_TR_NOOP("Leaves"),
+        QT_TR_NOOP("Points"), QT_TR_NOOP("Pending"), QT_TR_NOOP("Subst."), QT_TR_NOOP("Front")};
     static const char* const tips[ColumnCount] = {
         QT_TR_NOOP("Octree level (0 = root)"),
-        QT_TR_NOOP("Subtree roots in this level's list of the oblique cut (placeholders "
+        QT_TR_NOOP("Roots in L_C: subtree roots in this level's list of the oblique cut (placeholders "
                    "included): the boundary the next fix pass continues from"),
         QT_TR_NOOP("Nodes created at this level so far"),
         QT_TR_NOOP("Of those, leaves (at the deepest level, or a placeholder's leaf)"),
         QT_TR_NOOP("Points the level's nodes hold (parents hold a sample of their children)"),
         QT_TR_NOOP("Placeholders of collapsed leaves still rising through this level's list"),
-        QT_TR_NOOP("Placeholders that became leaves at this level"),
-        QT_TR_NOOP("Nodes of the view's render front at this level in the last frame "
+        QT_TR_NOOP("Substituted: placeholders that became leaves at this level"),
+        QT_TR_NOOP("Front nodes: the view's render front at this level in the last frame "
                    "(placeholders of leaves not yet substituted included)")};
     if (role == Qt::DisplayRole) {
         return tr(titles[section]);

@@ -16,6 +16,7 @@
 #include <QDropEvent>
 #include <QFileDialog>
 #include <QFileInfo>
+#include <QGuiApplication>
 #include <QImage>
 #include <QLabel>
 #include <QLocale>
@@ -254,7 +255,6 @@ void MainWindow::connectActions() {
         m_chartsPanel->setFrame(stats);
         m_cutPanel->setFrontNodes(stats.frontNodesPerLevel);
         m_pointsDrawn = stats.pointsDrawn;
-        m_fps = stats.fps;
         m_lastFrameStats = stats;
         m_lastFrame.start();
     });
@@ -414,10 +414,18 @@ void MainWindow::dropEvent(QDropEvent* event) {
 
 void MainWindow::loadSettings() {
     QSettings settings;
-    restoreGeometry(settings.value("window/geometry").toByteArray());
-    if (!restoreState(settings.value("window/state").toByteArray())) {
-        // First start: room for the cut panel's level table (eight columns) and its tree.
-        resizeDocks({findChild<QDockWidget*>(QStringLiteral("cutDock"))}, {590}, Qt::Horizontal);
+    const bool placed = restoreGeometry(settings.value("window/geometry").toByteArray());
+    if (!placed) {
+        // First start: most of the screen, centred.
+        const QRect screen = QGuiApplication::primaryScreen() != nullptr
+                                 ? QGuiApplication::primaryScreen()->availableGeometry()
+                                 : QRect(0, 0, 1280, 800);
+        const QSize size(screen.width() * 9 / 10, screen.height() * 9 / 10);
+        resize(size);
+        move(screen.center() - QPoint(size.width() / 2, size.height() / 2));
+    }
+    if (!placed || !restoreState(settings.value("window/state").toByteArray())) {
+        applyDefaultDockSizes(size());
     }
     m_recentFiles = settings.value("recentFiles").toStringList();
     while (m_recentFiles.size() > kMaxRecentFiles) {
@@ -425,6 +433,16 @@ void MainWindow::loadSettings() {
     }
     m_buildPanel->loadSettings(settings);
     applyViewParameters(m_buildPanel->viewParameters());
+}
+
+void MainWindow::applyDefaultDockSizes(QSize window) {
+    // The cut panel wide enough for every column of its level table (never more than 45 % of
+    // the window), the charts a third of the height: the view keeps the rest.
+    const int cutWidth =
+        std::min(m_cutPanel->widthForAllLevelColumns(), window.width() * 45 / 100);
+    resizeDocks({findChild<QDockWidget*>(QStringLiteral("cutDock"))}, {cutWidth}, Qt::Horizontal);
+    resizeDocks({findChild<QDockWidget*>(QStringLiteral("chartsDock"))}, {window.height() / 3},
+                Qt::Vertical);
 }
 
 void MainWindow::saveSettings() const {
@@ -493,7 +511,7 @@ void MainWindow::updateStatus() {
     // The view draws on demand: with nothing changing for a while it is idle, not slow.
     constexpr qint64 kIdleMs = 1500;
     m_fpsLabel->setText(m_lastFrame.isValid() && m_lastFrame.elapsed() < kIdleMs
-                            ? tr("%1 fps").arg(m_fps, 0, 'f', 1)
+                            ? tr("%1 fps").arg(m_chartsPanel->frameRate(), 0, 'f', 1)
                             : tr("idle"));
     // A .omh beyond the memory budget: its points come and go with the view.
     const FrameStats& frame = m_lastFrameStats;

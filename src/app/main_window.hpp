@@ -49,6 +49,9 @@ public:
     QStringList recentFiles() const { return m_recentFiles; }
     // The error dialog currently shown (nullptr when none).
     QMessageBox* errorDialog() const;
+    // The first start's dock layout for a window of `window`'s size: the cut panel wide enough
+    // for all level columns, the charts a third of the height.
+    void applyDefaultDockSizes(QSize window);
 
 public slots:
     // What File -> Open does after its dialog: pipeline 1 (PLY/LAS/XYZ), 2 (.oms) or 3 (.omh).
@@ -99,7 +102,6 @@ private:
     QProgressBar* m_progressBar = nullptr;
     QTimer m_statusTimer;
     std::size_t m_pointsDrawn = 0;
-    double m_fps = 0.0;
     FrameStats m_lastFrameStats; // the paged-points figures of the last frame
     QElapsedTimer m_lastFrame; // since the view's last frame
 };

@@ -6,33 +6,69 @@
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QFont>
+#include <QFontMetrics>
 #include <QLineSeries>
 #include <QMenu>
+#include <QCategoryAxis>
+#include <QCursor>
 #include <QTextStream>
-#include <QValueAxis>
+#include <QToolTip>
 #include <algorithm>
+#include <cmath>
 
 namespace omicron {
 
-TimeSeriesChart::TimeSeriesChart(const QString& title, const QString& unit,
+namespace {
+
+// Labels an axis with round ticks over [from, to]: a category axis whose categories end on
+// the ticks, labelled on their values (a plain value axis can only printf its labels).
+void setTicks(QCategoryAxis* axis, double from, double to, int targetCount, ChartUnit unit) {
+    const AxisTicks ticks = roundTicks(from, to, targetCount, unit);
+    const QStringList labels = tickLabels(ticks);
+    for (const QString& label : axis->categoriesLabels()) {
+        axis->remove(label);
+    }
+    // The first category starts just below the first tick, so that tick gets its label too.
+    axis->setStartValue(ticks.values.empty() ? from : ticks.values.front() - ticks.step * 1e-6);
+    for (std::size_t i = 0; i < ticks.values.size(); ++i) {
+        axis->append(labels.at(static_cast<qsizetype>(i)), ticks.values[i]);
+    }
+    axis->setRange(from, to);
+}
+
+QCategoryAxis* makeAxis(QChart* chart, const QFont& font) {
+    auto* axis = new QCategoryAxis(chart);
+    axis->setLabelsPosition(QCategoryAxis::AxisLabelsPositionOnValue);
+    axis->setLabelsFont(font);
+    return axis;
+}
+
+// Ticks as many as their labels have room for: one per this many pixels of the plot area.
+constexpr int kPixelsPerTimeTick = 48;
+constexpr int kPixelsPerValueTick = 24;
+constexpr int kGrowthTicks = 4; // the round steps an axis grows by
+
+} // namespace
+
+TimeSeriesChart::TimeSeriesChart(const QString& title, const QString& unit, ChartUnit scale,
                                  const QStringList& lineNames, QWidget* parent)
-    : QChartView(parent), m_title(title), m_unit(unit) {
+    : QChartView(parent), m_title(title), m_unit(unit), m_scale(scale) {
     auto* chart = new QChart();
     chart->setMargins(QMargins(2, 2, 2, 2));
+    chart->setTitle(title);
+    // Small panels: short labels in a small font; the units are in the tick labels.
+    QFont smallFont = chart->font();
+    smallFont.setPointSizeF(7.0);
+    QFont titleFont = chart->titleFont();
+    titleFont.setPointSizeF(8.0);
+    titleFont.setBold(true);
+    chart->setTitleFont(titleFont);
     chart->legend()->setVisible(lineNames.size() > 1);
     chart->legend()->setAlignment(Qt::AlignBottom);
-    // Small panels: short labels in a small font, the unit in the title instead of axis titles.
-    chart->setTitle(QStringLiteral("%1 (%2)").arg(title, unit));
-    QFont labelFont = chart->font();
-    labelFont.setPointSizeF(7.0);
-    m_axisX = new QValueAxis(chart);
-    m_axisX->setLabelFormat(QStringLiteral("%.3g"));
-    m_axisX->setLabelsFont(labelFont);
-    m_axisX->setTickCount(5);
-    m_axisY = new QValueAxis(chart);
-    m_axisY->setLabelFormat(QStringLiteral("%.3g"));
-    m_axisY->setLabelsFont(labelFont);
-    m_axisY->setTickCount(4);
+    chart->legend()->setFont(smallFont);
+    chart->legend()->setShowToolTips(true); // a name cut short shows whole on hover
+    m_axisX = makeAxis(chart, smallFont);
+    m_axisY = makeAxis(chart, smallFont);
     chart->addAxis(m_axisX, Qt::AlignBottom);
     chart->addAxis(m_axisY, Qt::AlignLeft);
     for (const QString& name : lineNames) {
@@ -41,6 +77,10 @@ TimeSeriesChart::TimeSeriesChart(const QString& title, const QString& unit,
         chart->addSeries(series);
         series->attachAxis(m_axisX);
         series->attachAxis(m_axisY);
+        connect(series, &QLineSeries::hovered, this,
+                [this, series](const QPointF& point, bool state) {
+                    showPointValue(series, point, state);
+                });
         m_lines.push_back(series);
     }
     // QChartView made a chart of its own, which setChart() only releases: delete it.
@@ -49,7 +89,9 @@ TimeSeriesChart::TimeSeriesChart(const QString& title, const QString& unit,
     delete defaultChart;
     setRenderHint(QPainter::Antialiasing);
     setMinimumSize(220, 160);
-    setToolTip(tr("%1. Right-click to export the chart as PNG or its data as CSV.").arg(title));
+    setToolTip(tr("%1 (%2). Hover a line for exact values; right-click to export the chart as "
+                  "PNG or its data as CSV.")
+                   .arg(title, unit));
     clear();
 }
 
@@ -75,20 +117,102 @@ void TimeSeriesChart::clear() {
     }
     m_maxSeconds = 1.0;
     m_maxValue = 1.0;
-    m_axisX->setRange(0.0, m_maxSeconds);
-    m_axisY->setRange(0.0, m_maxValue);
+    if (!m_sharedTime) {
+        m_timeFrom = 0.0;
+        m_timeTo = m_maxSeconds;
+    }
+    updateTicks();
+}
+
+void TimeSeriesChart::setTimeRange(double fromSeconds, double toSeconds) {
+    m_sharedTime = true;
+    if (fromSeconds != m_timeFrom || toSeconds != m_timeTo) {
+        m_timeFrom = fromSeconds;
+        m_timeTo = toSeconds;
+        updateTicks();
+    }
+}
+
+double TimeSeriesChart::timeFrom() const {
+    return m_timeFrom;
+}
+
+double TimeSeriesChart::timeTo() const {
+    return m_timeTo;
+}
+
+QStringList TimeSeriesChart::axisLabels() const {
+    return m_axisX->categoriesLabels() + m_axisY->categoriesLabels();
+}
+
+void TimeSeriesChart::resizeEvent(QResizeEvent* event) {
+    QChartView::resizeEvent(event);
+    placePlotArea();
+    updateTicks();
+}
+
+void TimeSeriesChart::updateTicks() {
+    const QRectF area = chart()->plotArea();
+    const int timeTicks = std::clamp(static_cast<int>(area.width()) / kPixelsPerTimeTick, 2, 8);
+    const int valueTicks =
+        std::clamp(static_cast<int>(area.height()) / kPixelsPerValueTick, 2, 5);
+    setTicks(m_axisX, m_timeFrom, m_timeTo, timeTicks, ChartUnit::Seconds);
+    setTicks(m_axisY, 0.0, m_maxValue, valueTicks, m_scale);
+}
+
+void TimeSeriesChart::placePlotArea() {
+    const QFontMetrics labels(m_axisY->labelsFont());
+    const QFontMetrics title(chart()->titleFont());
+    const QFontMetrics legend(chart()->legend()->font());
+    // Room on the left for the widest label an axis of this unit writes ("1.5 GiB").
+    const int left = labels.horizontalAdvance(QStringLiteral("000.0 GiB")) + 14;
+    const int top = title.height() + 16;
+    const int bottom = labels.height() + 14 +
+                       (chart()->legend()->isVisible() ? legend.height() + 20 : 0);
+    const QRectF area(left, top, std::max(10, width() - left - 14),
+                      std::max(10, height() - top - bottom));
+    chart()->setPlotArea(area);
 }
 
 void TimeSeriesChart::growAxes(double seconds, double value) {
-    // Axes only grow (by steps of a quarter) so a live chart does not jitter every sample.
-    if (seconds > m_maxSeconds) {
-        m_maxSeconds = seconds * 1.25;
-        m_axisX->setRange(0.0, m_maxSeconds);
+    // Axes only grow, to a round value with room to spare, so a live chart does not jitter
+    // every sample and its last tick is labelled.
+    bool grown = false;
+    if (!m_sharedTime && seconds > m_maxSeconds) {
+        m_maxSeconds = roundAxisEnd(seconds * 1.2, kGrowthTicks, ChartUnit::Seconds);
+        m_timeTo = m_maxSeconds;
+        grown = true;
     }
     if (value > m_maxValue) {
-        m_maxValue = value * 1.25;
-        m_axisY->setRange(0.0, m_maxValue);
+        m_maxValue = roundAxisEnd(value * 1.1, kGrowthTicks, m_scale);
+        grown = true;
     }
+    if (grown) {
+        updateTicks();
+    }
+}
+
+void TimeSeriesChart::showPointValue(const QLineSeries* series, const QPointF& point,
+                                     bool hovered) {
+    if (!hovered) {
+        QToolTip::hideText();
+        return;
+    }
+    // The sample nearest the pointer on this line (the hover point lies between samples).
+    const QList<QPointF> points = series->points();
+    const auto nearest = std::min_element(points.begin(), points.end(),
+                                          [&](const QPointF& a, const QPointF& b) {
+                                              return std::abs(a.x() - point.x()) <
+                                                     std::abs(b.x() - point.x());
+                                          });
+    if (nearest == points.end()) {
+        return;
+    }
+    QToolTip::showText(QCursor::pos(),
+                       tr("%1 at %2 s: %3 %4")
+                           .arg(series->name(), exactValue(nearest->x(), ChartUnit::Seconds),
+                                exactValue(nearest->y(), m_scale), m_unit),
+                       this);
 }
 
 bool TimeSeriesChart::exportPng(const QString& path, QString* error) {

@@ -1,8 +1,12 @@
-// ChartsPanel and its TimeSeriesChart: sampling at <= 10 Hz, the ideal line, and PNG/CSV
-// export (with errors that name the file).
+// ChartsPanel and its TimeSeriesChart: sampling at <= 10 Hz, the ideal line, PNG/CSV export
+// (with errors that name the file), axes in human units at round ticks, one time axis for all
+// charts (full history or following), and the frame rate from the first frame.
+#include "chart_scale.hpp"
 #include "charts_panel.hpp"
+#include "frame_rate_meter.hpp"
 #include "time_series_chart.hpp"
 
+#include <QComboBox>
 #include <QFile>
 #include <QImage>
 #include <QLineSeries>
@@ -19,6 +23,13 @@ private slots:
     void exportsPngAndCsv();
     void exportErrorsNameTheFile();
     void memoryChartDrawsTheBudgetWhenOneIsSet();
+    void ticksAreRoundAndLabelledInHumanUnits_data();
+    void ticksAreRoundAndLabelledInHumanUnits();
+    void exactValuesForTooltips();
+    void frameRateMeterCountsFromTheFirstFrame();
+    void frameRateIsChartedFromTheFirstFrameLikeCpuPerFrame();
+    void chartsShareOneTimeAxisFullOrFollowing();
+    void chartAxesGrowToRoundLabelledEnds();
 };
 
 void TestChartsPanel::samplesProgressAndFrames() {
@@ -77,8 +88,8 @@ void TestChartsPanel::chartsTheLeafToDrawnDelayOfTheFrames() {
     TimeSeriesChart* delay = panel.chart(QStringLiteral("Insertion delay"));
     QVERIFY(delay != nullptr);
     QCOMPARE(delay->lineCount(), 3);
-    QVERIFY(delay->line(0)->name().contains(QStringLiteral("drawn")));
-    QVERIFY(delay->line(2)->name().contains(QStringLiteral("sorted -> inserted")));
+    QCOMPARE(delay->line(0)->name(), QStringLiteral("median")); // leaf -> drawn
+    QCOMPARE(delay->line(2)->name(), QStringLiteral("sort wait")); // sorted -> inserted
     panel.startBuild();
     // Three frames before the next sample: 10 leaves at 40 ms (max 90), 1 at 5 ms (max 5),
     // 30 at 70 ms (max 300); one frame that drew no new leaf.
@@ -108,7 +119,7 @@ void TestChartsPanel::chartsTheLeafToDrawnDelayOfTheFrames() {
 
 void TestChartsPanel::exportsPngAndCsv() {
     QTemporaryDir dir;
-    TimeSeriesChart chart(QStringLiteral("Front size"), QStringLiteral("nodes"),
+    TimeSeriesChart chart(QStringLiteral("Front size"), QStringLiteral("nodes"), ChartUnit::Count,
                           {QStringLiteral("front nodes")});
     chart.resize(400, 300);
     chart.append(0, 0.5, 10.0);
@@ -129,7 +140,7 @@ void TestChartsPanel::exportsPngAndCsv() {
 }
 
 void TestChartsPanel::exportErrorsNameTheFile() {
-    TimeSeriesChart chart(QStringLiteral("Frame rate"), QStringLiteral("fps"),
+    TimeSeriesChart chart(QStringLiteral("Frame rate"), QStringLiteral("fps"), ChartUnit::Rate,
                           {QStringLiteral("fps")});
     const QString bad = QStringLiteral("/nonexistent-folder/chart.csv");
     QString error;
@@ -154,6 +165,141 @@ void TestChartsPanel::memoryChartDrawsTheBudgetWhenOneIsSet() {
     // Automatic (half of physical memory): no line, the chart keeps its scale.
     panel.setMemoryBudget(0);
     QTRY_COMPARE(memory->line(2)->count(), 0);
+}
+
+void TestChartsPanel::ticksAreRoundAndLabelledInHumanUnits_data() {
+    QTest::addColumn<double>("max");
+    QTest::addColumn<int>("unit");
+    QTest::addColumn<QStringList>("labels");
+    const auto row = [](const char* name, double max, ChartUnit unit, QStringList labels) {
+        QTest::newRow(name) << max << static_cast<int>(unit) << labels;
+    };
+    row("points in millions", 30.25e6, ChartUnit::Count,
+        {"0", "10 M", "20 M", "30 M"});
+    row("points in tenths of millions", 1.5e6, ChartUnit::Count,
+        {"0", "0.5 M", "1.0 M", "1.5 M"});
+    row("nodes in thousands", 6000.0 * 4, ChartUnit::Count, {"0", "10 k", "20 k"});
+    row("few nodes", 12.0, ChartUnit::Count, {"0", "5", "10"});
+    row("a billion points", 2.2e9, ChartUnit::Count, {"0", "1 G", "2 G"});
+    row("memory in MiB", 500.0, ChartUnit::Mebibytes, {"0", "200 MiB", "400 MiB"});
+    row("memory in GiB", 1.5 * 1024, ChartUnit::Mebibytes,
+        {"0", "0.5 GiB", "1.0 GiB", "1.5 GiB"});
+    row("frame ms", 96.8, ChartUnit::Milliseconds, {"0", "20 ms", "40 ms", "60 ms", "80 ms"});
+    row("long delays in s", 6000.0, ChartUnit::Milliseconds, {"0", "2 s", "4 s", "6 s"});
+    row("seconds", 9.2, ChartUnit::Seconds, {"0 s", "2 s", "4 s", "6 s", "8 s"});
+    row("fps", 60.0, ChartUnit::Rate, {"0", "20", "40", "60"});
+}
+
+void TestChartsPanel::ticksAreRoundAndLabelledInHumanUnits() {
+    QFETCH(double, max);
+    QFETCH(int, unit);
+    QFETCH(QStringList, labels);
+    const AxisTicks ticks = roundTicks(0.0, max, 4, static_cast<ChartUnit>(unit));
+    QCOMPARE(tickLabels(ticks), labels);
+    for (const double value : ticks.values) {
+        QVERIFY(value <= max);
+    }
+}
+
+void TestChartsPanel::exactValuesForTooltips() {
+    QCOMPARE(exactValue(24213457.0, ChartUnit::Count), QLocale().toString(24213457));
+    QCOMPARE(exactValue(12.456, ChartUnit::Milliseconds), QLocale().toString(12.46, 'f', 2));
+    QCOMPARE(exactValue(1423.46, ChartUnit::Mebibytes), QLocale().toString(1423.5, 'f', 1));
+}
+
+void TestChartsPanel::frameRateMeterCountsFromTheFirstFrame() {
+    FrameRateMeter meter;
+    QCOMPARE(meter.rateAt(5.0), 0.0);
+    // 60 frames a second from t = 10 s: the first sample 0.1 s in already has the rate.
+    for (int i = 0; i < 6; ++i) {
+        meter.frameAt(10.0 + i / 60.0);
+    }
+    QCOMPARE(meter.rateAt(10.1), 60.0);
+    for (int i = 6; i < 120; ++i) {
+        meter.frameAt(10.0 + i / 60.0);
+    }
+    QVERIFY(std::abs(meter.rateAt(12.0 - 1e-9) - 60.0) < 1.01);
+    // Frames stop: the rate falls to 0 once the last frame is a second old.
+    QVERIFY(meter.rateAt(12.5) > 0.0);
+    QCOMPARE(meter.rateAt(13.1), 0.0);
+    // After the pause, 3 frames in 0.2 s are 15 fps, not diluted by the idle second.
+    meter.frameAt(20.0);
+    meter.frameAt(20.1);
+    meter.frameAt(20.2);
+    QCOMPARE(meter.rateAt(20.2), 15.0);
+}
+
+// The frame rate chart gets its first sample with the first frame, as CPU per frame does.
+void TestChartsPanel::frameRateIsChartedFromTheFirstFrameLikeCpuPerFrame() {
+    ChartsPanel panel;
+    panel.resize(900, 400);
+    panel.show();
+    panel.startBuild();
+    TimeSeriesChart* cpu = panel.chart(QStringLiteral("CPU per frame"));
+    TimeSeriesChart* fps = panel.chart(QStringLiteral("Frame rate"));
+    QTest::qWait(2 * ChartsPanel::kSampleIntervalMs);
+    QCOMPARE(cpu->line(0)->count(), 0);
+    QCOMPARE(fps->line(0)->count(), 0);
+    FrameStats frame;
+    frame.frameMs = 8.0;
+    frame.fps = 0.0; // the view's own one-second figure is not there yet
+    for (int i = 0; i < 4; ++i) {
+        panel.setFrame(frame);
+        QTest::qWait(10);
+    }
+    QTRY_VERIFY(cpu->line(0)->count() >= 1);
+    QCOMPARE(fps->line(0)->count(), cpu->line(0)->count());
+    QCOMPARE(fps->line(0)->at(0).x(), cpu->line(0)->at(0).x());
+    QVERIFY2(fps->line(0)->at(0).y() >= 4.0, qPrintable(QString::number(fps->line(0)->at(0).y())));
+    QCOMPARE(cpu->line(0)->at(0).y(), 8.0);
+}
+
+void TestChartsPanel::chartsShareOneTimeAxisFullOrFollowing() {
+    ChartsPanel panel;
+    panel.resize(900, 400);
+    panel.show();
+    panel.startBuild();
+    const auto sameAxis = [&] {
+        for (const TimeSeriesChart* chart : panel.charts()) {
+            if (chart->timeFrom() != panel.charts().front()->timeFrom() ||
+                chart->timeTo() != panel.charts().front()->timeTo()) {
+                return false;
+            }
+        }
+        return true;
+    };
+    QTest::qWait(5 * ChartsPanel::kSampleIntervalMs);
+    QVERIFY(sameAxis());
+    QCOMPARE(panel.charts().front()->timeFrom(), 0.0);
+    // Full history: from the open to past the last sample.
+    const TimeSeriesChart* memory = panel.chart(QStringLiteral("Memory"));
+    QVERIFY(memory->line(0)->count() > 0);
+    QVERIFY(panel.charts().front()->timeTo() >= memory->line(0)->points().last().x());
+    // Following the last 10 s: a 10 s window on every chart, whichever its samples.
+    panel.setFollowSeconds(10.0);
+    QVERIFY(sameAxis());
+    QCOMPARE(panel.charts().front()->timeTo() - panel.charts().front()->timeFrom(), 10.0);
+    auto* combo = panel.findChild<QComboBox*>(QStringLiteral("timeWindow"));
+    QVERIFY(combo != nullptr);
+    QCOMPARE(combo->currentData().toDouble(), 10.0);
+    combo->setCurrentIndex(0);
+    QCOMPARE(panel.followSeconds(), 0.0);
+    QVERIFY(sameAxis());
+    QCOMPARE(panel.charts().front()->timeFrom(), 0.0);
+}
+
+void TestChartsPanel::chartAxesGrowToRoundLabelledEnds() {
+    TimeSeriesChart chart(QStringLiteral("Inserted points"), QStringLiteral("points"),
+                          ChartUnit::Count, {QStringLiteral("inserted")});
+    chart.resize(300, 200);
+    chart.append(0, 0.4, 2.42e7);
+    chart.append(0, 7.3, 8.07e6);
+    const QStringList labels = chart.axisLabels();
+    QVERIFY(labels.contains(QStringLiteral("0 s")));
+    QVERIFY2(labels.contains(QStringLiteral("20 M")), qPrintable(labels.join(", ")));
+    for (const QString& label : labels) {
+        QVERIFY2(!label.contains(QLatin1Char('e')), qPrintable(label));
+    }
 }
 
 QTEST_MAIN(TestChartsPanel)

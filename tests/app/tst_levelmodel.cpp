@@ -69,7 +69,7 @@ void TestLevelModel::reportsTheNumbersOfEachLevel() {
     QCOMPARE(model.index(6, LevelModel::Points).data(Qt::EditRole).toULongLong(),
              quint64(3 * 64 * 10));
     QCOMPARE(model.headerData(LevelModel::CutRoots, Qt::Horizontal).toString(),
-             QStringLiteral("Roots in L_C"));
+             QStringLiteral("Roots"));
     QVERIFY(
         !model.headerData(LevelModel::Nodes, Qt::Horizontal, Qt::ToolTipRole).toString().isEmpty());
     QVERIFY(!model.headerData(0, Qt::Vertical).isValid());
@@ -107,7 +107,7 @@ void TestLevelModel::frontNodesFillTheirColumn() {
     QCOMPARE(model.value(3, LevelModel::FrontNodes), quint64(40));
     QCOMPARE(model.index(2, LevelModel::FrontNodes).data(Qt::EditRole).toULongLong(), quint64(12));
     QCOMPARE(model.headerData(LevelModel::FrontNodes, Qt::Horizontal).toString(),
-             QStringLiteral("Front nodes"));
+             QStringLiteral("Front"));
     changed.clear();
     model.setFrontNodes(front);
     QCOMPARE(changed.count(), 0);
