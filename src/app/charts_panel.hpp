@@ -33,7 +33,8 @@ public:
     const std::vector<TimeSeriesChart*>& charts() const { return m_charts; }
     TimeSeriesChart* chart(const QString& title) const;
 
-    // The time axis of every chart: 0 shows the whole history, N > 0 follows the last N s.
+    // The time axis of every chart: 0 shows the whole history, N > 0 follows the last N s
+    // (the panel's menu offers 10 s, 30 s, 1 min and 5 min; the window persists the choice).
     void setFollowSeconds(double seconds);
     double followSeconds() const { return m_followSeconds; }
     // Frames per second now, as the Frame rate chart draws it (FrameRateMeter).

@@ -427,6 +427,7 @@ void MainWindow::loadSettings() {
     if (!placed || !restoreState(settings.value("window/state").toByteArray())) {
         applyDefaultDockSizes(size());
     }
+    m_chartsPanel->setFollowSeconds(settings.value("charts/followSeconds", 0.0).toDouble());
     m_recentFiles = settings.value("recentFiles").toStringList();
     while (m_recentFiles.size() > kMaxRecentFiles) {
         m_recentFiles.removeLast();
@@ -449,6 +450,7 @@ void MainWindow::saveSettings() const {
     QSettings settings;
     settings.setValue("window/geometry", saveGeometry());
     settings.setValue("window/state", saveState());
+    settings.setValue("charts/followSeconds", m_chartsPanel->followSeconds());
     settings.setValue("recentFiles", m_recentFiles);
     m_buildPanel->saveSettings(settings);
 }

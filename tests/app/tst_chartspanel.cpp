@@ -11,6 +11,7 @@
 #include <QImage>
 #include <QLineSeries>
 #include <QTemporaryDir>
+#include <QToolTip>
 #include <QtTest>
 
 using namespace omicron;
@@ -30,6 +31,7 @@ private slots:
     void frameRateIsChartedFromTheFirstFrameLikeCpuPerFrame();
     void chartsShareOneTimeAxisFullOrFollowing();
     void chartAxesGrowToRoundLabelledEnds();
+    void hoveringALineShowsTheExactValue();
 };
 
 void TestChartsPanel::samplesProgressAndFrames() {
@@ -300,6 +302,24 @@ void TestChartsPanel::chartAxesGrowToRoundLabelledEnds() {
     for (const QString& label : labels) {
         QVERIFY2(!label.contains(QLatin1Char('e')), qPrintable(label));
     }
+}
+
+void TestChartsPanel::hoveringALineShowsTheExactValue() {
+    TimeSeriesChart chart(QStringLiteral("Inserted points"), QStringLiteral("points"),
+                          ChartUnit::Count, {QStringLiteral("inserted")});
+    chart.resize(300, 200);
+    chart.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&chart));
+    chart.append(0, 1.0, 1000.0);
+    chart.append(0, 2.0, 24213457.0);
+    // Qt reports a point on the line between samples: the tooltip names the nearest sample.
+    emit chart.line(0)->hovered(QPointF(1.9, 23e6), true);
+    QTRY_VERIFY(QToolTip::isVisible());
+    QCOMPARE(QToolTip::text(), QStringLiteral("inserted at %1 s: %2 points")
+                                   .arg(QLocale().toString(2.0, 'f', 2),
+                                        QLocale().toString(24213457)));
+    emit chart.line(0)->hovered(QPointF(1.9, 23e6), false);
+    QTRY_VERIFY(!QToolTip::isVisible());
 }
 
 QTEST_MAIN(TestChartsPanel)

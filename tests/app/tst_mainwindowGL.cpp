@@ -153,6 +153,7 @@ void TestMainWindowGL::openingASharedFileBuildsAndFillsThePanels() {
         QVERIFY(summary != nullptr);
         QTRY_VERIFY(summary->text().contains(QStringLiteral("(packed points)")));
 
+        window.chartsPanel()->setFollowSeconds(30.0);
         // Screenshot of the view.
         const QString shot = dir.filePath(QStringLiteral("shot.png"));
         QVERIFY(window.saveScreenshot(shot));
@@ -164,6 +165,7 @@ void TestMainWindowGL::openingASharedFileBuildsAndFillsThePanels() {
     QCOMPARE(again.recentFiles().value(0), path);
     QCOMPARE(again.buildPanel()->pipelineOptions().build.maxLevel, 9);
     QCOMPARE(again.buildPanel()->pipelineOptions().storage, PointStorage::Packed);
+    QCOMPARE(again.chartsPanel()->followSeconds(), 30.0);
 }
 
 void TestMainWindowGL::malformedFileShowsANamedErrorAndTheAppStaysUsable() {
