@@ -77,6 +77,21 @@ TEST(CliMemoryBudget, SpilledBuildGivesTheSameLevels) {
     EXPECT_TRUE(contains(text.out, "beyond the memory budget:")) << text.out;
 }
 
+// Beyond the budget the cloud is in a scratch file and the save sweeps it in batches of an
+// eighth of the budget: the same file as the build in memory.
+TEST(CliMemoryBudget, SaveBeyondTheBudgetWritesTheSameFile) {
+    OMICRON_REQUIRE_SHARED_FILE(dragon, "dragon.ply");
+    TempDir dir;
+    const auto reference = runCli({"build", dragon, "--save", dir.file("reference.omh")});
+    ASSERT_EQ(reference.exitCode, 0) << reference.err;
+    const auto spilled = runCli({"build", dragon, "--memory-budget", "4M", "--temp-dir",
+                                 dir.path().string(), "--save", dir.file("spilled.omh")});
+    ASSERT_EQ(spilled.exitCode, 0) << spilled.err;
+    EXPECT_TRUE(contains(spilled.out, "beyond the memory budget:")) << spilled.out;
+    EXPECT_EQ(test::readBytes(dir.file("spilled.omh")), test::readBytes(dir.file("reference.omh")));
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 2);
+}
+
 struct BudgetUsage {
     const char* name;
     std::vector<std::string> args;

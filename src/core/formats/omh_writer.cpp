@@ -1,5 +1,7 @@
 #include "formats/omh_writer.hpp"
 
+#include "formats/omh_payload_sweep.hpp"
+#include "formats/omh_record_sink.hpp"
 #include "io/atomic_file_writer.hpp"
 #include "io/file_stream.hpp"
 
@@ -13,8 +15,10 @@ namespace omicron {
 
 namespace {
 
-// Point records are encoded into a block of about this size before being hashed and written.
-constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
+// The deep levels are written in one sweep over the cloud (omh_payload_sweep), a batch of
+// subtrees holding at most this many points at a time (and at most an eighth of the budget
+// for a cloud in a scratch file): their splat attributes are held until written.
+constexpr std::uint64_t kSweepBatchPoints = std::uint64_t{4} << 20;
 
 template <typename T> void store(std::uint8_t* at, const T& value) {
     std::memcpy(at, &value, sizeof(T));
@@ -28,61 +32,6 @@ std::uint8_t childMask(const Hierarchy& hierarchy, int level, const OctreeNode& 
     }
     return mask;
 }
-
-// Encodes point records into blocks, hashing and writing each block when full.
-class RecordSink {
-public:
-    RecordSink(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::RecordLayout& layout)
-        : m_file(file), m_cloud(hierarchy.cloud()), m_layout(layout),
-          m_block(std::max<std::size_t>(1, kBlockBytes / layout.bytes) * layout.bytes) {}
-
-    // One held point of a node and its splat attributes (`estimatedNormal` only stored when
-    // the layout has room for it).
-    void add(std::uint32_t index, std::uint16_t encodedRadius, std::uint32_t estimatedNormal) {
-        if (m_used == m_block.size()) {
-            flush();
-        }
-        std::uint8_t* record = m_block.data() + m_used;
-        const AttributeSet attributes = m_cloud.attributes();
-        store(record, m_cloud.position(index));
-        if (attributes.has(Attribute::Normal)) {
-            store(record + m_layout.point.normalOffset, m_cloud.normals()[index]);
-        }
-        if (attributes.has(Attribute::Color)) {
-            store(record + m_layout.point.colorOffset, m_cloud.color(index));
-        }
-        if (attributes.has(Attribute::Intensity)) {
-            store(record + m_layout.point.intensityOffset, m_cloud.intensities()[index]);
-        }
-        store(record + m_layout.radiusOffset, encodedRadius);
-        if (m_layout.estimatedNormalOffset != 0) {
-            store(record + m_layout.estimatedNormalOffset, estimatedNormal);
-        }
-        m_used += m_layout.bytes;
-    }
-
-    // Writes what is pending and returns the checksum of everything since the last call.
-    std::uint64_t finishSection() {
-        flush();
-        const std::uint64_t digest = m_checksum->digest();
-        m_checksum = std::make_unique<oms::PayloadChecksum>();
-        return digest;
-    }
-
-private:
-    void flush() {
-        m_checksum->update(m_block.data(), m_used);
-        m_file.write(m_block.data(), m_used);
-        m_used = 0;
-    }
-
-    AtomicFileWriter& m_file;
-    const SortedCloud& m_cloud;
-    omh::RecordLayout m_layout;
-    std::vector<std::uint8_t> m_block;
-    std::size_t m_used = 0;
-    std::unique_ptr<oms::PayloadChecksum> m_checksum = std::make_unique<oms::PayloadChecksum>();
-};
 
 // The splat attributes of the nodes in file order, estimated a batch of nodes at a time in
 // parallel (the writer itself is sequential): a save pays for every node's estimate once.
@@ -277,9 +226,20 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
         file.write(records.data(), records.size());
     }
 
-    RecordSink sink(file, hierarchy, layout);
+    // The top levels (whose nodes cover more than a batch) a level at a time; their points are
+    // few. The rest in one sweep over the cloud, each level at its offset in the file.
+    const std::uint64_t defaultBatch =
+        cloud.fileBacked()
+            ? std::clamp<std::uint64_t>(cloud.residentBudget() / 8 / pointBytes(cloud.attributes()),
+                                        1, kSweepBatchPoints)
+            : kSweepBatchPoints;
+    const std::uint64_t sweepBatch =
+        options.sweepBatchPoints > 0 ? options.sweepBatchPoints : defaultBatch;
+    const SubtreePoints subtrees = subtreeHeldPoints(hierarchy);
+    const int firstSweptLevel = omhSweepFirstLevel(subtrees, sweepBatch);
+    OmhRecordSink sink(file, cloud, layout);
     NodeSplatBatches splats(hierarchy);
-    for (int level = 0; level < levels; ++level) {
+    for (int level = 0; level < firstSweptLevel; ++level) {
         omh::LevelEntry& entry = header.levels[static_cast<std::size_t>(level)];
         for (std::size_t i = 0; i < entry.nodes; ++i) {
             const OctreeNode& node = hierarchy.node(level, i);
@@ -294,6 +254,10 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
             options.afterLevel(level);
         }
     }
+    const omh::LevelEntry& deepest = header.levels.back();
+    file.extendTo(deepest.payloadOffset + deepest.points * layout.bytes);
+    writeOmhLevelsInOneSweep(file, hierarchy, layout, header.levels, subtrees, firstSweptLevel,
+                             sweepBatch, options.afterLevel);
 
     const auto footerBytes = omh::encodeFooter(header.totalNodes, header.totalPoints);
     file.write(footerBytes.data(), footerBytes.size());

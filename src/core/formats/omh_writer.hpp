@@ -17,6 +17,10 @@ struct OmhWriteOptions {
     // Called after each level's point records were handed to the file (level 0 first). For
     // progress, and for the test that kills a save half-way (see omicron-cli build --save).
     std::function<void(int level)> afterLevel;
+    // Points held by a batch of the one-pass sweep that writes the deep levels (0: the
+    // default, 4 Mi, and at most an eighth of the budget for a cloud in a scratch file). The
+    // bytes written do not depend on it; tests vary it.
+    std::uint64_t sweepBatchPoints = 0;
 };
 
 // The header fields a build determines: its parameters and counts.

@@ -128,6 +128,47 @@ void AtomicFileWriter::writeAt(std::uint64_t offset, const void* data, std::size
     }
 }
 
+void AtomicFileWriter::extendTo(std::uint64_t size) {
+    if (size < m_bytesWritten) {
+        throw OutputError(m_targetPath + ": extendTo(" + std::to_string(size) + ") below the " +
+                          std::to_string(m_bytesWritten) + " bytes written");
+    }
+    flushBuffer();
+    const auto from = static_cast<off_t>(m_onFile);
+    const auto count = static_cast<off_t>(size - m_onFile);
+    if (count > 0) {
+        // fallocate rather than posix_fallocate: where the file system cannot reserve, the
+        // region is left sparse (ftruncate) instead of being written with zeros first.
+        if (::fallocate(m_fd, 0, from, count) != 0) {
+            const int error = errno;
+            if (error == ENOSPC || error == EDQUOT) {
+                fail("no room for the " + std::to_string(size) + " bytes of the file", error);
+            }
+            if (::ftruncate(m_fd, static_cast<off_t>(size)) != 0) {
+                fail("cannot extend the file to " + std::to_string(size) + " bytes", errno);
+            }
+        }
+    }
+    if (::lseek(m_fd, static_cast<off_t>(size), SEEK_SET) < 0) {
+        fail("seek failed", errno);
+    }
+    m_onFile = m_bytesWritten = size;
+    m_windowStart = size; // the regions before it are released by their writers
+}
+
+void AtomicFileWriter::startWriteBack(std::uint64_t offset, std::uint64_t count) {
+    sync_file_range(m_fd, static_cast<off_t>(offset), static_cast<off_t>(count),
+                    SYNC_FILE_RANGE_WRITE);
+}
+
+void AtomicFileWriter::dropFromCache(std::uint64_t offset, std::uint64_t count) {
+    sync_file_range(m_fd, static_cast<off_t>(offset), static_cast<off_t>(count),
+                    SYNC_FILE_RANGE_WAIT_BEFORE | SYNC_FILE_RANGE_WRITE |
+                        SYNC_FILE_RANGE_WAIT_AFTER);
+    posix_fadvise(m_fd, static_cast<off_t>(offset), static_cast<off_t>(count),
+                  POSIX_FADV_DONTNEED);
+}
+
 void AtomicFileWriter::commit() {
     flushBuffer();
     if (::fsync(m_fd) != 0) {

@@ -33,6 +33,17 @@ public:
     // precedes the data it covers. Throws OutputError.
     void writeAt(std::uint64_t offset, const void* data, std::size_t count);
 
+    // Makes the file `size` bytes long (size >= bytesWritten()), its space reserved on disk
+    // at once, so that regions beyond what was written sequentially can be filled with
+    // writeAt in any order; write() continues at `size`. A disk without the room is an
+    // OutputError naming the bytes needed, before anything is written there.
+    void extendTo(std::uint64_t size);
+
+    // For regions filled with writeAt: starts writing [offset, offset + count) back to disk,
+    // or waits for that and drops it from the page cache (see dropBehind in the .cpp).
+    void startWriteBack(std::uint64_t offset, std::uint64_t count);
+    void dropFromCache(std::uint64_t offset, std::uint64_t count);
+
     std::uint64_t bytesWritten() const { return m_bytesWritten; }
     const std::string& targetPath() const { return m_targetPath; }
 

@@ -6,6 +6,7 @@
 #include "io/input_error.hpp"
 #include "test_files.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <cstring>
@@ -156,6 +157,35 @@ TEST(OmhRoundTrip, SyntheticShapesInEveryModeAreBitExact) {
                 expectRoundTrip(built, dir);
             }
         }
+    }
+}
+
+// The deep levels are written side by side in one sweep, a batch of subtrees at a time: the
+// file does not depend on the batch size, from one point (every subtree alone, only the
+// deepest level swept) to everything at once (the whole hierarchy one batch from the root),
+// for a built hierarchy and for one loaded from the file.
+TEST(OmhWriter, TheSweepsBatchSizeNeverChangesTheBytes) {
+    OMICRON_REQUIRE_SHARED_FILE(path, "lion.ply");
+    TempDir dir;
+    const BuildResult built = buildFile(path, options(7, LeafCollapse::Lossless));
+    const std::string reference = dir.file("reference.omh");
+    save(reference, built);
+    const auto loaded = loadAll(reference);
+    const omh::BuildInfo info = omhBuildInfo(built.builder->options(), built.builder->statistics());
+    for (const std::uint64_t batch : {std::uint64_t{1}, std::uint64_t{997}, std::uint64_t{60'000},
+                                      std::uint64_t{1} << 40}) {
+        SCOPED_TRACE(batch);
+        OmhWriteOptions write;
+        write.sweepBatchPoints = batch;
+        std::vector<int> levelsWritten;
+        write.afterLevel = [&](int level) { levelsWritten.push_back(level); };
+        writeOmh(dir.file("built.omh"), built.builder->hierarchy(), info, write);
+        EXPECT_EQ(readBytes(dir.file("built.omh")), readBytes(reference));
+        std::sort(levelsWritten.begin(), levelsWritten.end());
+        EXPECT_EQ(levelsWritten, (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));
+        write.afterLevel = nullptr;
+        writeOmh(dir.file("loaded.omh"), *loaded, info, write);
+        EXPECT_EQ(readBytes(dir.file("loaded.omh")), readBytes(reference));
     }
 }
 

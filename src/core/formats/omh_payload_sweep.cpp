@@ -1,0 +1,119 @@
+#include "formats/omh_payload_sweep.hpp"
+
+#include "formats/omh_record_sink.hpp"
+
+#include <algorithm>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <utility>
+
+namespace omicron {
+
+namespace {
+
+std::uint64_t coveredEnd(const OctreeNode& node) {
+    return std::uint64_t{node.coveredBegin} + node.coveredCount;
+}
+
+} // namespace
+
+SubtreePoints subtreeHeldPoints(const Hierarchy& hierarchy) {
+    const int levelCount = hierarchy.maxLevel() + 1;
+    SubtreePoints subtrees(static_cast<std::size_t>(levelCount));
+    for (int level = levelCount - 1; level >= 0; --level) {
+        std::vector<std::uint64_t>& held = subtrees[static_cast<std::size_t>(level)];
+        held.resize(hierarchy.nodeCount(level));
+        for (std::size_t i = 0; i < held.size(); ++i) {
+            const OctreeNode& node = hierarchy.node(level, i);
+            held[i] = node.pointCount;
+            for (std::uint32_t c = 0; c < node.childCount; ++c) {
+                held[i] += subtrees[static_cast<std::size_t>(level) + 1][node.firstChild + c];
+            }
+        }
+    }
+    return subtrees;
+}
+
+int omhSweepFirstLevel(const SubtreePoints& subtrees, std::uint64_t maxBatchPoints) {
+    const int deepest = static_cast<int>(subtrees.size()) - 1;
+    for (int level = 0; level < deepest; ++level) {
+        const std::vector<std::uint64_t>& held = subtrees[static_cast<std::size_t>(level)];
+        if (std::all_of(held.begin(), held.end(),
+                        [&](std::uint64_t points) { return points <= maxBatchPoints; })) {
+            return level;
+        }
+    }
+    return deepest;
+}
+
+void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy,
+                              const omh::RecordLayout& layout, std::vector<omh::LevelEntry>& levels,
+                              const SubtreePoints& subtrees, int firstLevel,
+                              std::uint64_t maxBatchPoints,
+                              const std::function<void(int level)>& afterLevel) {
+    const SortedCloud& cloud = hierarchy.cloud();
+    const int levelCount = hierarchy.maxLevel() + 1;
+    std::vector<OmhRecordSink> sinks;
+    sinks.reserve(static_cast<std::size_t>(levelCount - firstLevel));
+    for (int level = firstLevel; level < levelCount; ++level) {
+        sinks.emplace_back(file, cloud, layout,
+                           levels[static_cast<std::size_t>(level)].payloadOffset);
+    }
+    // The next node of each level not yet written. Children are stored in their parents'
+    // order, so a batch's nodes at each level follow those of the level above: as many as
+    // the batch's nodes there have children.
+    std::vector<std::size_t> next(static_cast<std::size_t>(levelCount), 0);
+    std::vector<std::pair<int, std::size_t>> batch; // (level, index), level by level
+    std::vector<NodeSplats> splats;
+    tbb::enumerable_thread_specific<SplatScratch> scratch;
+
+    const std::vector<std::uint64_t>& rootPoints = subtrees[static_cast<std::size_t>(firstLevel)];
+    const std::size_t roots = rootPoints.size();
+    for (std::size_t begin = 0; begin < roots;) {
+        cloud.keepWithinBudget(); // what the previous batch read may go first
+        std::size_t end = begin + 1;
+        for (std::uint64_t points = rootPoints[begin];
+             end < roots && points + rootPoints[end] <= maxBatchPoints; ++end) {
+            points += rootPoints[end];
+        }
+        // A built hierarchy's subtrees cover one stretch of the cloud: read it in bulk.
+        cloud.willRead(hierarchy.node(firstLevel, begin).coveredBegin,
+                       coveredEnd(hierarchy.node(firstLevel, end - 1)));
+        batch.clear();
+        std::size_t count = end - begin;
+        for (int level = firstLevel; level < levelCount && count > 0; ++level) {
+            std::size_t& first = next[static_cast<std::size_t>(level)];
+            std::size_t children = 0;
+            for (std::size_t i = first; i < first + count; ++i) {
+                batch.emplace_back(level, i);
+                children += hierarchy.node(level, i).childCount;
+            }
+            first += count;
+            count = children;
+        }
+        splats.resize(batch.size());
+        tbb::parallel_for(std::size_t{0}, batch.size(), [&](std::size_t b) {
+            hierarchy.nodeSplats(hierarchy.node(batch[b].first, batch[b].second), splats[b],
+                                 scratch.local());
+        });
+        for (std::size_t b = 0; b < batch.size(); ++b) {
+            const OctreeNode& node = hierarchy.node(batch[b].first, batch[b].second);
+            OmhRecordSink& sink = sinks[static_cast<std::size_t>(batch[b].first - firstLevel)];
+            const NodeSplats& nodeSplats = splats[b];
+            for (std::uint32_t p = 0; p < node.pointCount; ++p) {
+                sink.add(node.heldPoint(p), nodeSplats.radii[p],
+                         nodeSplats.normals.empty() ? 0u : nodeSplats.normals[p]);
+            }
+        }
+        begin = end;
+    }
+    for (int level = firstLevel; level < levelCount; ++level) {
+        levels[static_cast<std::size_t>(level)].payloadChecksum =
+            sinks[static_cast<std::size_t>(level - firstLevel)].finishSection();
+        if (afterLevel) {
+            afterLevel(level);
+        }
+    }
+}
+
+} // namespace omicron

@@ -1,0 +1,50 @@
+// Encodes the points a .omh level holds into its point records (position, the cloud's
+// normal/colour/intensity, splat radius and estimated normal) a block at a time, hashes them
+// for the level's checksum and hands each full block to the file: appended, or written at the
+// level's own offset when several levels are filled side by side (omh_payload_sweep).
+#pragma once
+
+#include "formats/oms_format.hpp"
+#include "formats/omh_format.hpp"
+#include "io/atomic_file_writer.hpp"
+#include "points/sorted_cloud.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace omicron {
+
+class OmhRecordSink {
+public:
+    // Appends to `file`.
+    OmhRecordSink(AtomicFileWriter& file, const SortedCloud& cloud, const omh::RecordLayout& layout);
+    // Writes at `offset` onwards (inside a region made by AtomicFileWriter::extendTo), and
+    // lets what it wrote leave the page cache as it goes: a level of a multi-gigabyte file is
+    // written once and not read back.
+    OmhRecordSink(AtomicFileWriter& file, const SortedCloud& cloud, const omh::RecordLayout& layout,
+                  std::uint64_t offset);
+
+    // One held point (a SortedCloud index) and its splat attributes; `estimatedNormal` is
+    // stored only when the layout has room for it.
+    void add(std::uint32_t index, std::uint16_t encodedRadius, std::uint32_t estimatedNormal);
+
+    // Writes what is pending and returns the checksum of everything since the last call.
+    std::uint64_t finishSection();
+
+private:
+    void flush();
+
+    AtomicFileWriter& m_file;
+    const SortedCloud& m_cloud;
+    omh::RecordLayout m_layout;
+    std::vector<std::uint8_t> m_block;
+    std::size_t m_used = 0;
+    std::unique_ptr<oms::PayloadChecksum> m_checksum;
+    bool m_positional = false;
+    std::uint64_t m_regionStart = 0; // positional: where the sink started
+    std::uint64_t m_at = 0;          // positional: where the next block goes
+    std::uint64_t m_released = 0;    // positional: bytes from m_regionStart out of the cache
+};
+
+} // namespace omicron
