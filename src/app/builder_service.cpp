@@ -2,6 +2,7 @@
 
 #include "formats/omh_writer.hpp"
 #include "formats/oms_writer.hpp"
+#include "formats/potree_writer.hpp"
 #include "io/cloud_export.hpp"
 
 #include <QFileInfo>
@@ -135,6 +136,44 @@ bool BuilderService::saveHierarchy(const QString& path) {
     return true;
 }
 
+bool BuilderService::exportPotree(const QString& folder) {
+    const auto hierarchy = m_pipeline->hierarchy();
+    if (!hierarchy || !hierarchy->publishedCut().complete || m_busy) {
+        emit failed(folder, tr("Nothing to export: wait until the hierarchy is complete."));
+        return false;
+    }
+    PotreeExportOptions options;
+    options.name = sourceTitle().section(QLatin1Char('.'), 0, 0).toStdString();
+    // A loaded .omh's cloud holds the parents' copies: its header's count is the input's.
+    options.inputPoints = m_pipeline->statistics().inputPoints;
+    Job job{QFileInfo(folder).fileName(), false,
+            [this, file = folder.toStdString(), hierarchy, options,
+             folder](BuildPipeline& pipeline) mutable {
+                options.cancel = &pipeline.cancelFlag();
+                options.onProgress = [this](std::uint64_t done, std::uint64_t total) {
+                    m_jobTotal.store(total, std::memory_order_relaxed);
+                    m_jobDone.store(done, std::memory_order_relaxed);
+                };
+                try {
+                    const PotreeExportSummary summary =
+                        omicron::exportPotree(*hierarchy, file, options);
+                    return JobOutcome{
+                        {},
+                        tr("Exported %1 points (%2 dropped by leaf collapse) to the Potree "
+                           "folder %3")
+                            .arg(summary.points)
+                            .arg(summary.droppedPoints)
+                            .arg(folder)};
+                } catch (const PotreeExportCancelled&) {
+                    return JobOutcome{{}, tr("Potree export to %1 cancelled").arg(folder)};
+                }
+            },
+            folder};
+    job.reportsProgress = true;
+    submit(std::move(job));
+    return true;
+}
+
 void BuilderService::submit(Job job) {
     if (m_busy) {
         // Last request wins; the running job stops at its next cancellation check and
@@ -152,6 +191,12 @@ void BuilderService::startJob(Job job) {
     setBusy(true);
     m_currentIsBuild = job.build;
     m_currentOpensSource = job.opensSource;
+    m_currentReportsProgress = job.reportsProgress;
+    m_jobDone = 0;
+    m_jobTotal = 0;
+    if (job.reportsProgress) {
+        m_poll.start();
+    }
     if (job.build) {
         // Polls before the worker's run starts would see the previous run's final phase.
         m_staleGeneration = m_pipeline->progress().generation;
@@ -185,7 +230,7 @@ void BuilderService::startJob(Job job) {
 
 void BuilderService::onWorkerDone(const Job& job, JobOutcome outcome, const QString& error) {
     joinWorker();
-    if (job.build) {
+    if (job.build || job.reportsProgress) {
         m_poll.stop();
         poll(); // the final numbers, whatever the timer phase
     }
@@ -235,6 +280,13 @@ void BuilderService::setBusy(bool busy) {
 }
 
 void BuilderService::poll() {
+    if (!m_currentIsBuild) {
+        if (m_currentReportsProgress && m_jobTotal.load(std::memory_order_relaxed) > 0) {
+            emit jobProgressChanged(m_jobDone.load(std::memory_order_relaxed),
+                                    m_jobTotal.load(std::memory_order_relaxed));
+        }
+        return;
+    }
     const PipelineProgress progress = m_pipeline->progress();
     const auto hierarchy = m_pipeline->hierarchy();
     if (hierarchy != m_lastHierarchy) {

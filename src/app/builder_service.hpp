@@ -16,6 +16,7 @@
 #include <QObject>
 #include <QString>
 #include <QTimer>
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -51,6 +52,10 @@ public:
     // Pipeline 3: loads a .omh hierarchy file; and writes the current hierarchy as .omh.
     void openHierarchy(const QString& path);
     bool saveHierarchy(const QString& path);
+    // Writes the current (complete) hierarchy as a Potree 2.0 folder, each input point once
+    // (formats/potree_writer.hpp): progress through jobProgressChanged, cancel() stops it and
+    // leaves neither the folder nor its temporary one.
+    bool exportPotree(const QString& folder);
 
     // Stops the running job (no-op when idle), also during the bounds pre-pass of a PLY or
     // XYZ file (the kept cloud and hierarchy then stay); a pending request is dropped too.
@@ -86,8 +91,11 @@ signals:
     // The sorter's preview sample while pipeline 1 reads.
     void previewChanged(const omicron::PreviewSample& preview, const omicron::CubeTransform& cube);
     void buildFinished(const omicron::PipelineResult& result);
-    // A file job (export, save) succeeded: `message` says what was written.
+    // A file job (export, save) succeeded or was cancelled: `message` says what was written.
     void jobFinished(const QString& message);
+    // A file job that reports progress (the Potree export): `done` of `total` units, at most
+    // 10 times a second while it runs.
+    void jobProgressChanged(quint64 done, quint64 total);
     // Any failure: the file involved (may be empty) and the problem, for an error dialog.
     void failed(const QString& path, const QString& message);
 
@@ -101,8 +109,9 @@ private:
         QString title;
         bool build = true; // builds report progress and end with buildFinished
         std::function<JobOutcome(BuildPipeline&)> work;
-        QString path;             // the file involved, for error messages
-        bool opensSource = false; // reads a file or the scene (replaces the kept cloud)
+        QString path;                 // the file involved, for error messages
+        bool opensSource = false;     // reads a file or the scene (replaces the kept cloud)
+        bool reportsProgress = false; // a file job that sets m_jobDone / m_jobTotal
     };
 
     // Writes the kept sorted cloud to a file on the worker; returns the status-bar message.
@@ -126,6 +135,10 @@ private:
     QElapsedTimer m_buildClock;
     bool m_currentIsBuild = false;
     bool m_currentOpensSource = false;
+    bool m_currentReportsProgress = false;
+    // A file job's progress, written by the worker, polled by the timer.
+    std::atomic<std::uint64_t> m_jobDone{0};
+    std::atomic<std::uint64_t> m_jobTotal{0};
     std::shared_ptr<const Hierarchy> m_lastHierarchy;
     PipelineProgress m_lastProgress;
     std::uint64_t m_staleGeneration = 0;

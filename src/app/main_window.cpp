@@ -149,6 +149,14 @@ void MainWindow::connectActions() {
             exportPoints(path);
         }
     });
+    connect(m_ui->actionExportPotree, &QAction::triggered, this, [this] {
+        // A folder to create (or an earlier export to replace): typed as a save target.
+        const QString folder =
+            askSavePath(tr("Export Potree Folder"), tr("Potree 2.0 folders (*)"), QString());
+        if (!folder.isEmpty()) {
+            exportPotree(folder);
+        }
+    });
     connect(m_ui->actionSaveScreenshot, &QAction::triggered, this, [this] {
         const QString path = askSavePath(tr("Save Screenshot"), tr("PNG images (*.png)"), "png");
         if (!path.isEmpty() && !saveScreenshot(path)) {
@@ -323,6 +331,10 @@ void MainWindow::connectService() {
     });
     connect(m_service, &BuilderService::jobFinished, this,
             [this](const QString& message) { statusBar()->showMessage(message, 10000); });
+    connect(m_service, &BuilderService::jobProgressChanged, this,
+            [this](quint64 done, quint64 total) {
+                m_progressBar->setValue(static_cast<int>(1000.0 * double(done) / double(total)));
+            });
     connect(m_service, &BuilderService::failed, this, &MainWindow::showError);
     connect(m_service, &BuilderService::busyChanged, this, [this](bool busy) {
         m_buildPanel->setBusy(busy);
@@ -358,6 +370,13 @@ void MainWindow::exportSortedStream(const QString& path) {
 
 void MainWindow::exportPoints(const QString& path) {
     m_service->exportPoints(path);
+}
+
+void MainWindow::exportPotree(const QString& folder) {
+    if (m_service->exportPotree(folder)) {
+        m_progressBar->setValue(0);
+        statusBar()->showMessage(tr("Exporting %1 to Potree… (Cancel: Ctrl+.)").arg(folder));
+    }
 }
 
 bool MainWindow::saveScreenshot(const QString& path) {
@@ -496,6 +515,7 @@ void MainWindow::updateActions() {
     const bool haveCloud = m_service->hasCompleteCloud();
     m_ui->actionExportSortedStream->setEnabled(haveCloud);
     m_ui->actionExportPoints->setEnabled(haveCloud);
+    m_ui->actionExportPotree->setEnabled(m_service->hierarchy() != nullptr);
     m_ui->actionSaveHierarchy->setEnabled(m_service->hierarchy() != nullptr);
 }
 

@@ -60,6 +60,9 @@ public slots:
     void saveHierarchy(const QString& path);
     void exportSortedStream(const QString& path);
     void exportPoints(const QString& path);
+    // File -> Export Potree…: the hierarchy as a Potree 2.0 folder, on the service's worker,
+    // with the status bar's progress bar; Cancel stops it and leaves no folder.
+    void exportPotree(const QString& folder);
     bool saveScreenshot(const QString& path);
     void showError(const QString& path, const QString& message);
 

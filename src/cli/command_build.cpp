@@ -1,5 +1,6 @@
 // omicron-cli build: pipeline 1 (unsorted cloud -> sorter -> builder) or pipeline 2 (.oms ->
 // builder), then the build statistics as text or JSON.
+#include "build_args.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "formats/omh_writer.hpp"
@@ -18,28 +19,6 @@
 namespace omicron::cli {
 
 namespace {
-
-LeafCollapse parseCollapse(const std::string& text) {
-    if (text == "off") {
-        return LeafCollapse::Off;
-    }
-    if (text == "lossless") {
-        return LeafCollapse::Lossless;
-    }
-    if (text == "paper") {
-        return LeafCollapse::Paper;
-    }
-    throw UsageError("--collapse takes off, lossless or paper, found '" + text + "'");
-}
-
-double parseRatio(const std::string& text) {
-    char* end = nullptr;
-    const double ratio = std::strtod(text.c_str(), &end);
-    if (end == text.c_str() || *end != '\0' || !(ratio > 0.0 && ratio <= 1.0)) {
-        throw UsageError("--ratio takes a number in (0, 1], found '" + text + "'");
-    }
-    return ratio;
-}
 
 struct SavedFile {
     std::string path; // empty without --save
@@ -139,16 +118,9 @@ void printText(const PipelineResult& run, const BuildOptions& options, const Sav
 }
 
 int runBuild(const std::vector<std::string>& args) {
-    const ParsedArgs parsed = parseArgs(args, withOptions({{"depth", true},
-                                                           {"ratio", true},
-                                                           {"worklist", true},
-                                                           {"collapse", true},
-                                                           {"threads", true},
-                                                           {"chunks", true},
-                                                           {"store", true},
-                                                           {"json", false},
-                                                           {"save", true}},
-                                                          kMemoryOptionSpecs));
+    const ParsedArgs parsed = parseArgs(
+        args, withOptions(withOptions(kBuildOptionSpecs, {{"json", false}, {"save", true}}),
+                          kMemoryOptionSpecs));
     if (parsed.help) {
         printCommandHelp(buildCommand());
         return 0;
@@ -157,35 +129,17 @@ int runBuild(const std::vector<std::string>& args) {
         throw UsageError("expected one input file, found " +
                          std::to_string(parsed.positionals.size()) + " arguments");
     }
-    BuildOptions options;
-    if (const auto depth = parsed.value("depth")) {
-        options.maxLevel = static_cast<int>(parseInteger(*depth, "depth", 1, morton::kMaxLevel));
-    }
-    if (const auto ratio = parsed.value("ratio")) {
-        options.ratio = parseRatio(*ratio);
-    }
-    if (const auto worklist = parsed.value("worklist")) {
-        options.worklistSize = parseInteger(*worklist, "worklist", 1, 1 << 20);
-    }
-    if (const auto collapse = parsed.value("collapse")) {
-        options.collapse = parseCollapse(*collapse);
-    }
-    const int threads = threadsOption(parsed);
-    options.threads = threads;
-    const int chunks = sortChunksOption(parsed);
+    const BuildArgs build = buildArgs(parsed);
+    const BuildOptions& options = build.options;
     tbb::global_control threadLimit(tbb::global_control::max_allowed_parallelism,
-                                    static_cast<std::size_t>(threads));
-
-    PointStorage storage = PointStorage::Exact;
-    if (const auto store = parsed.value("store"); store && !parsePointStorage(*store, storage)) {
-        throw UsageError("--store takes exact or packed, found '" + *store + "'");
-    }
+                                    static_cast<std::size_t>(build.threads));
 
     const std::string& path = parsed.positionals[0];
     const MemoryOptions memory = memoryOptions(parsed, parsed.value("save").value_or(""));
     BuildPipeline pipeline;
     const PipelineResult run = runInterruptibly(
-        pipeline, path, {options, chunks, storage, memory.budgetBytes, memory.tempDir});
+        pipeline, path,
+        {options, build.sortChunks, build.storage, memory.budgetBytes, memory.tempDir});
     SavedFile saved;
     if (const auto savePath = parsed.value("save")) { // the finished hierarchy, pipeline 3's input
         writeOmh(*savePath, *pipeline.hierarchy(), omhBuildInfo(options, run.stats), saveOptions());

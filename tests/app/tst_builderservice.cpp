@@ -7,6 +7,7 @@
 #include "io/point_reader.hpp"
 #include "scene/scene_generator.hpp"
 
+#include <QDir>
 #include <QElapsedTimer>
 #include <QFile>
 #include <QFileInfo>
@@ -71,6 +72,7 @@ private slots:
     void malformedFileIsReportedByNameAndTheHierarchyIsKept();
     void exportsLoadBackIdentically();
     void savedHierarchyLoadsBackWithIdenticalStatistics();
+    void potreeExportStoresEveryPointOnceAndCancelLeavesNothing();
     void cancelMidBuildEndsTheRun();
     void cancelDuringTheBoundsPrePassKeepsThePreviousCloud();
     void firstPixelsComeFromTheBoundsPrePass();
@@ -258,6 +260,57 @@ void TestBuilderService::savedHierarchyLoadsBackWithIdenticalStatistics() {
     service.openHierarchy(damaged);
     QTRY_VERIFY_WITH_TIMEOUT(failed.count() == 1, kBuildTimeoutMs);
     QVERIFY(failed.first().at(1).toString().contains(QStringLiteral("damaged.omh")));
+}
+
+// File > Export Potree: off the GUI thread with progress; every point once; Cancel mid-way
+// leaves neither the folder nor a temporary one; asked too early, it is refused by name.
+void TestBuilderService::potreeExportStoresEveryPointOnceAndCancelLeavesNothing() {
+    QTemporaryDir dir;
+    BuilderService service;
+    service.setOptions(testOptions(6));
+    QSignalSpy finished(&service, &BuilderService::buildFinished);
+    QSignalSpy failed(&service, &BuilderService::failed);
+    QSignalSpy jobs(&service, &BuilderService::jobFinished);
+    QSignalSpy progress(&service, &BuilderService::jobProgressChanged);
+    const QString folder = dir.filePath(QStringLiteral("potree"));
+    QVERIFY(!service.exportPotree(folder)); // no hierarchy yet
+    QTRY_COMPARE(failed.count(), 1);
+    QVERIFY(failed.first().at(0).toString() == folder);
+    failed.clear();
+
+    constexpr std::uint64_t kPoints = 1'000'000;
+    service.openGeneratedScene(kPoints, 7);
+    const PipelineResult built = waitForBuild(finished, failed);
+    QVERIFY(built.stats.complete);
+    QTRY_VERIFY(!service.busy());
+
+    QVERIFY(service.exportPotree(folder));
+    QVERIFY(service.busy()); // the GUI thread returned at once; the worker writes
+    QTRY_VERIFY_WITH_TIMEOUT(jobs.count() == 1, kBuildTimeoutMs);
+    QTRY_VERIFY(!service.busy());
+    QCOMPARE(failed.count(), 0);
+    QVERIFY2(jobs.first().at(0).toString().contains(QStringLiteral("Exported 1000000 points")),
+             qPrintable(jobs.first().at(0).toString()));
+    QFile metadata(folder + QStringLiteral("/metadata.json"));
+    QVERIFY(metadata.open(QIODevice::ReadOnly));
+    QVERIFY(metadata.readAll().contains("\"points\": 1000000,"));
+    QVERIFY(progress.count() >= 1);
+    const auto last = progress.last();
+    QCOMPARE(last.at(0).value<quint64>(), last.at(1).value<quint64>()); // ends at its total
+
+    // Cancelled right after it starts: a message, no folder, no temporary folder.
+    const QString cancelled = dir.filePath(QStringLiteral("cancelled"));
+    QVERIFY(service.exportPotree(cancelled));
+    service.cancel();
+    QTRY_VERIFY_WITH_TIMEOUT(jobs.count() == 2, kBuildTimeoutMs);
+    QTRY_VERIFY(!service.busy());
+    QCOMPARE(failed.count(), 0);
+    QVERIFY2(jobs.last().at(0).toString().contains(QStringLiteral("cancelled")),
+             qPrintable(jobs.last().at(0).toString()));
+    QVERIFY(!QFileInfo::exists(cancelled));
+    const QStringList leftovers =
+        QDir(dir.path()).entryList(QDir::AllEntries | QDir::Hidden | QDir::NoDotAndDotDot);
+    QCOMPARE(leftovers, QStringList{QStringLiteral("potree")});
 }
 
 void TestBuilderService::cancelMidBuildEndsTheRun() {

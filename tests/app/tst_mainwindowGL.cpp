@@ -26,6 +26,8 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QLineSeries>
+#include <QMenu>
+#include <QMenuBar>
 #include <QMessageBox>
 #include <QSettings>
 #include <QSignalSpy>
@@ -68,6 +70,7 @@ private slots:
     void openingASharedFileBuildsAndFillsThePanels();
     void malformedFileShowsANamedErrorAndTheAppStaysUsable();
     void savedHierarchyOpensThroughTheFileMenu();
+    void potreeExportThroughTheFileMenu();
     void closingMidBuildReturnsPromptly();
     void aCloudBeyondTheMemoryBudgetSortsOnDisk();
     void renderModeMenuAndPanelDriveTheView();
@@ -232,6 +235,33 @@ void TestMainWindowGL::savedHierarchyOpensThroughTheFileMenu() {
         QCOMPARE(loaded.stats.levels[level].points, built.stats.levels[level].points);
     }
     QTRY_VERIFY(window.cloudView()->hierarchy() == window.service()->hierarchy());
+}
+
+// File > Export Potree…: in the File menu, enabled once a hierarchy exists, writes the folder
+// on the service's worker while the window stays responsive.
+void TestMainWindowGL::potreeExportThroughTheFileMenu() {
+    QTemporaryDir dir;
+    MainWindow window;
+    window.show();
+    auto* action = window.findChild<QAction*>(QStringLiteral("actionExportPotree"));
+    QVERIFY(action != nullptr);
+    QVERIFY(!action->isEnabled());
+    QVERIFY(window.menuBar()->actions().first()->menu()->actions().contains(action));
+
+    QSignalSpy finished(window.service(), &BuilderService::buildFinished);
+    window.openDefaultScene(20'000);
+    QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 1, kBuildTimeoutMs);
+    QTRY_VERIFY(!window.service()->busy());
+    QVERIFY(action->isEnabled());
+    const QString folder = dir.filePath(QStringLiteral("scene-potree"));
+    window.exportPotree(folder);
+    QTRY_VERIFY_WITH_TIMEOUT(QFileInfo::exists(folder + QStringLiteral("/metadata.json")) &&
+                                 !window.service()->busy(),
+                             kBuildTimeoutMs);
+    QVERIFY(window.errorDialog() == nullptr);
+    QFile metadata(folder + QStringLiteral("/metadata.json"));
+    QVERIFY(metadata.open(QIODevice::ReadOnly));
+    QVERIFY(metadata.readAll().contains("\"points\": 20000,"));
 }
 
 // The panel's memory budget and scratch folder apply to the next open: a budget below the

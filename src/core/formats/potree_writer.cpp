@@ -1,14 +1,16 @@
 #include "formats/potree_writer.hpp"
 
-#include <algorithm>
+#include "formats/potree_additive.hpp"
+#include "formats/potree_attributes.hpp"
+#include "formats/potree_hierarchy.hpp"
+#include "io/atomic_folder.hpp"
+
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <deque>
 #include <filesystem>
 #include <initializer_list>
-#include <limits>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -16,57 +18,18 @@ namespace omicron {
 
 namespace {
 
-enum PotreeNodeType : std::uint8_t { kNormal = 0, kLeaf = 1, kProxy = 2 };
-constexpr std::size_t kRecordBytes = 22;
-
-template <typename T> void store(std::uint8_t* at, const T& value) {
-    std::memcpy(at, &value, sizeof(T));
-}
-
-// omicron octant (z << 2 | y << 1 | x) -> Potree child index (x << 2 | y << 1 | z).
-unsigned potreeChildIndex(morton::Code code) {
-    const unsigned octant = static_cast<unsigned>(code & 7u);
-    return ((octant & 1u) << 2) | (octant & 2u) | ((octant >> 2) & 1u);
-}
-
-std::int32_t quantize(float unit) {
-    const double steps = std::floor(static_cast<double>(unit) * kPotreeStepsPerEdge);
-    return static_cast<std::int32_t>(std::clamp(steps, 0.0, double(kPotreeStepsPerEdge - 1)));
-}
-
-struct NodeRef {
-    int level = 0;
-    std::uint32_t index = 0;
-};
-
-// A node's children in Potree's order: the order a loader expects them in a chunk.
-std::vector<NodeRef> potreeChildren(const Hierarchy& hierarchy, NodeRef ref) {
-    const OctreeNode& node = hierarchy.node(ref.level, ref.index);
-    std::vector<NodeRef> children;
-    for (std::uint32_t c = 0; c < node.childCount; ++c) {
-        children.push_back({ref.level + 1, node.firstChild + c});
+// What an existing folder may hold for an export to replace it: a Potree 2.0 export's files
+// (log.txt is PotreeConverter's). Anything else is the user's, and is never deleted.
+std::string refuseUnlessPotreeExport(const std::string& folder) {
+    for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+        const std::string name = entry.path().filename().string();
+        if (name != "metadata.json" && name != "hierarchy.bin" && name != "octree.bin" &&
+            name != "log.txt") {
+            return "it holds '" + name + "', which is not part of a Potree export";
+        }
     }
-    std::sort(children.begin(), children.end(), [&](NodeRef a, NodeRef b) {
-        return potreeChildIndex(hierarchy.node(a.level, a.index).code) <
-               potreeChildIndex(hierarchy.node(b.level, b.index).code);
-    });
-    return children;
+    return {};
 }
-
-std::uint8_t potreeChildMask(const Hierarchy& hierarchy, NodeRef ref) {
-    std::uint8_t mask = 0;
-    for (NodeRef child : potreeChildren(hierarchy, ref)) {
-        mask = static_cast<std::uint8_t>(
-            mask | (1u << potreeChildIndex(hierarchy.node(child.level, child.index).code)));
-    }
-    return mask;
-}
-
-struct ChunkRecord {
-    NodeRef node;
-    PotreeNodeType type = kNormal;
-    std::size_t proxyChunk = 0; // for proxies: the chunk that starts with this node
-};
 
 std::string number(double value) {
     char text[32];
@@ -97,146 +60,15 @@ std::string jsonEscape(const std::string& text) {
     return out;
 }
 
-} // namespace
+struct Geometry {
+    std::array<double, 3> boxMin;
+    double edge;
+    double scale;
+};
 
-PotreeExportSummary exportPotree(const Hierarchy& hierarchy, const std::string& folder,
-                                 const PotreeExportOptions& options) {
-    if (!hierarchy.publishedCut().complete || hierarchy.nodeCount(0) != 1) {
-        throw OutputError(folder + ": only a complete hierarchy can be exported");
-    }
-    if (options.stepSize < 1) {
-        throw OutputError(folder + ": the hierarchy step size must be at least 1");
-    }
-    std::error_code error;
-    std::filesystem::create_directories(folder, error);
-    if (error) {
-        throw OutputError(folder + ": cannot create the folder: " + error.message());
-    }
-    const std::filesystem::path dir(folder);
-    const SortedCloud& cloud = hierarchy.cloud();
-    const AttributeSet attributes = cloud.attributes();
-    const bool rgb = attributes.has(Attribute::Color);
-    const bool intensity = attributes.has(Attribute::Intensity);
-    const std::size_t pointBytes = 12 + (rgb ? 6 : 0) + (intensity ? 2 : 0);
-    const CubeTransform& cube = cloud.cube();
-    const std::array<double, 3> boxMin{cube.origin.x + cloud.sourceOffset().x,
-                                       cube.origin.y + cloud.sourceOffset().y,
-                                       cube.origin.z + cloud.sourceOffset().z};
-    const double scale = cube.edge / kPotreeStepsPerEdge;
-
-    PotreeExportSummary summary;
-    // octree.bin: every node's points, level by level; remember where each node went.
-    std::vector<std::vector<std::uint64_t>> byteOffsets(
-        static_cast<std::size_t>(hierarchy.maxLevel()) + 1);
-    std::array<double, 3> positionMin{}, positionMax{};
-    positionMin.fill(std::numeric_limits<double>::max());
-    positionMax.fill(std::numeric_limits<double>::lowest());
-    std::array<std::uint16_t, 3> rgbMin{65535, 65535, 65535}, rgbMax{0, 0, 0};
-    std::uint16_t intensityMin = 65535, intensityMax = 0;
-    int depth = 0;
-    {
-        AtomicFileWriter octree((dir / "octree.bin").string());
-        std::vector<std::uint8_t> record(pointBytes);
-        for (int level = 0; level <= hierarchy.maxLevel(); ++level) {
-            const std::size_t count = hierarchy.nodeCount(level);
-            depth = count > 0 ? level : depth;
-            auto& offsets = byteOffsets[static_cast<std::size_t>(level)];
-            offsets.resize(count);
-            for (std::size_t i = 0; i < count; ++i) {
-                const OctreeNode& node = hierarchy.node(level, i);
-                offsets[i] = octree.bytesWritten();
-                for (std::uint32_t p = 0; p < node.pointCount; ++p) {
-                    const std::uint32_t index = node.heldPoint(p);
-                    const glm::vec3 unit = cloud.position(index);
-                    for (int axis = 0; axis < 3; ++axis) {
-                        const std::int32_t stored = quantize(unit[axis]);
-                        store(record.data() + 4 * axis, stored);
-                        const double value = stored * scale + boxMin[axis];
-                        positionMin[axis] = std::min(positionMin[axis], value);
-                        positionMax[axis] = std::max(positionMax[axis], value);
-                    }
-                    std::size_t at = 12;
-                    if (rgb) {
-                        const glm::u8vec3 color = cloud.color(index);
-                        for (int c = 0; c < 3; ++c) {
-                            const auto value = static_cast<std::uint16_t>(color[c] * 257u);
-                            store(record.data() + at + 2 * c, value);
-                            rgbMin[c] = std::min(rgbMin[c], value);
-                            rgbMax[c] = std::max(rgbMax[c], value);
-                        }
-                        at += 6;
-                    }
-                    if (intensity) {
-                        const std::uint16_t value = cloud.intensities()[index];
-                        store(record.data() + at, value);
-                        intensityMin = std::min(intensityMin, value);
-                        intensityMax = std::max(intensityMax, value);
-                    }
-                    octree.write(record.data(), record.size());
-                }
-                ++summary.nodes;
-                summary.points += node.pointCount;
-            }
-        }
-        summary.octreeBytes = octree.bytesWritten();
-        octree.commit();
-    }
-
-    // hierarchy.bin: chunks laid out first (their sizes give the proxies' offsets), then
-    // written in order; the root's chunk comes first.
-    std::vector<std::vector<ChunkRecord>> chunks;
-    std::deque<NodeRef> chunkRoots{{0, 0}};
-    while (!chunkRoots.empty()) {
-        const NodeRef root = chunkRoots.front();
-        chunkRoots.pop_front();
-        std::vector<ChunkRecord> records;
-        std::deque<NodeRef> queue{root};
-        while (!queue.empty()) {
-            const NodeRef ref = queue.front();
-            queue.pop_front();
-            const OctreeNode& node = hierarchy.node(ref.level, ref.index);
-            ChunkRecord record{ref, node.childCount == 0 ? kLeaf : kNormal, 0};
-            if (node.childCount > 0 && ref.level - root.level == options.stepSize) {
-                record.type = kProxy;
-                record.proxyChunk = chunks.size() + 1 + chunkRoots.size();
-                chunkRoots.push_back(ref);
-            } else {
-                for (NodeRef child : potreeChildren(hierarchy, ref)) {
-                    queue.push_back(child);
-                }
-            }
-            records.push_back(record);
-        }
-        chunks.push_back(std::move(records));
-    }
-    std::vector<std::uint64_t> chunkOffsets(chunks.size() + 1, 0);
-    for (std::size_t c = 0; c < chunks.size(); ++c) {
-        chunkOffsets[c + 1] = chunkOffsets[c] + chunks[c].size() * kRecordBytes;
-    }
-    {
-        AtomicFileWriter file((dir / "hierarchy.bin").string());
-        std::array<std::uint8_t, kRecordBytes> bytes{};
-        for (const auto& chunk : chunks) {
-            for (const ChunkRecord& record : chunk) {
-                const OctreeNode& node = hierarchy.node(record.node.level, record.node.index);
-                const bool proxy = record.type == kProxy;
-                store(bytes.data() + 0, static_cast<std::uint8_t>(record.type));
-                store(bytes.data() + 1, potreeChildMask(hierarchy, record.node));
-                store(bytes.data() + 2, node.pointCount);
-                store(bytes.data() + 6,
-                      proxy ? chunkOffsets[record.proxyChunk]
-                            : byteOffsets[static_cast<std::size_t>(record.node.level)]
-                                         [record.node.index]);
-                store(bytes.data() + 14,
-                      proxy ? chunkOffsets[record.proxyChunk + 1] - chunkOffsets[record.proxyChunk]
-                            : std::uint64_t{node.pointCount} * pointBytes);
-                file.write(bytes.data(), bytes.size());
-            }
-        }
-        file.commit();
-    }
-    summary.chunks = chunks.size();
-
+std::string metadataJson(const PotreeExportOptions& options, const PotreeExportSummary& summary,
+                         const PotreeHierarchyFile& hierarchy, const Geometry& geometry,
+                         const PotreeRecordEncoder& encoder, int stepSize) {
     // Appended piece by piece: GCC 12's -Wrestrict misfires on "literal" + std::string.
     std::string json;
     const auto add = [&json](std::initializer_list<std::string_view> pieces) {
@@ -244,36 +76,122 @@ PotreeExportSummary exportPotree(const Hierarchy& hierarchy, const std::string& 
             json.append(piece);
         }
     };
-    const double edge = cube.edge;
+    std::string description("exported by omicron: ");
+    description.append(std::to_string(summary.inputPoints)).append(" input points, ");
+    description.append(std::to_string(summary.points)).append(" stored once each, ");
+    description.append(std::to_string(summary.droppedPoints));
+    description.append(" dropped by the paper's leaf collapse");
+    const std::array<double, 3>& min = geometry.boxMin;
+    const double edge = geometry.edge;
     add({"{\n  \"version\": \"2.0\",\n  \"name\": \"", jsonEscape(options.name), "\",\n"});
-    add({"  \"description\": \"exported by omicron\",\n"});
+    add({"  \"description\": \"", jsonEscape(description), "\",\n"});
     add({"  \"points\": ", std::to_string(summary.points), ",\n  \"projection\": \"\",\n"});
-    add({"  \"hierarchy\": {\n    \"firstChunkSize\": ", std::to_string(chunkOffsets[1]),
-         ",\n    \"stepSize\": ", std::to_string(options.stepSize), ",\n    \"depth\": ",
-         std::to_string(depth), "\n  },\n"});
-    add({"  \"offset\": ", triple(boxMin), ",\n  \"scale\": ", triple({scale, scale, scale}),
+    add({"  \"hierarchy\": {\n    \"firstChunkSize\": ", std::to_string(hierarchy.firstChunkSize),
+         ",\n    \"stepSize\": ", std::to_string(stepSize),
+         ",\n    \"depth\": ", std::to_string(hierarchy.depth), "\n  },\n"});
+    add({"  \"offset\": ", triple(min),
+         ",\n  \"scale\": ", triple({geometry.scale, geometry.scale, geometry.scale}),
          ",\n  \"spacing\": ", number(edge / 128.0), ",\n"});
-    add({"  \"boundingBox\": {\n    \"min\": ", triple(boxMin), ",\n    \"max\": ",
-         triple({boxMin[0] + edge, boxMin[1] + edge, boxMin[2] + edge}), "\n  },\n"});
-    add({"  \"encoding\": \"DEFAULT\",\n  \"attributes\": [\n"});
-    add({"    {\"name\": \"position\", \"description\": \"\", \"size\": 12, "
-         "\"numElements\": 3, \"elementSize\": 4, \"type\": \"int32\", \"min\": ",
-         triple(positionMin), ", \"max\": ", triple(positionMax), "}"});
-    if (rgb) {
-        add({",\n    {\"name\": \"rgb\", \"description\": \"\", \"size\": 6, "
-             "\"numElements\": 3, \"elementSize\": 2, \"type\": \"uint16\", \"min\": ",
-             triple({double(rgbMin[0]), double(rgbMin[1]), double(rgbMin[2])}), ", \"max\": ",
-             triple({double(rgbMax[0]), double(rgbMax[1]), double(rgbMax[2])}), "}"});
+    add({"  \"boundingBox\": {\n    \"min\": ", triple(min),
+         ",\n    \"max\": ", triple({min[0] + edge, min[1] + edge, min[2] + edge}), "\n  },\n"});
+    add({"  \"encoding\": \"DEFAULT\",\n  \"attributes\": ",
+         encoder.attributesJson(geometry.scale, min, "    "), "\n}\n"});
+    return json;
+}
+
+} // namespace
+
+PotreeExportSummary exportPotree(const Hierarchy& hierarchy, const std::string& folder,
+                                 const PotreeExportOptions& options) {
+    if (!hierarchy.publishedCut().complete || hierarchy.nodeCount(0) != 1) {
+        throw OutputError(folder + ": only a complete hierarchy can be exported");
     }
-    if (intensity) {
-        add({",\n    {\"name\": \"intensity\", \"description\": \"\", \"size\": 2, "
-             "\"numElements\": 1, \"elementSize\": 2, \"type\": \"uint16\", \"min\": [",
-             number(intensityMin), "], \"max\": [", number(intensityMax), "]}"});
+    if (hierarchy.residency() != nullptr) {
+        throw OutputError(folder +
+                          ": the hierarchy's points are paged in on demand (a .omh file larger "
+                          "than the memory budget); export the file with "
+                          "'omicron-cli export-potree FILE.omh DIR' instead");
     }
-    add({"\n  ]\n}\n"});
-    AtomicFileWriter metadata((dir / "metadata.json").string());
-    metadata.write(json);
+    if (options.stepSize < 1) {
+        throw OutputError(folder + ": the hierarchy step size must be at least 1");
+    }
+    AtomicFolder target(folder, refuseUnlessPotreeExport);
+    const SortedCloud& cloud = hierarchy.cloud();
+    const CubeTransform& cube = cloud.cube();
+    const Geometry geometry{{cube.origin.x + cloud.sourceOffset().x,
+                             cube.origin.y + cloud.sourceOffset().y,
+                             cube.origin.z + cloud.sourceOffset().z},
+                            cube.edge,
+                            cube.edge / kPotreeStepsPerEdge};
+    PotreeRecordEncoder encoder(cloud);
+    const std::size_t recordBytes = encoder.recordBytes();
+
+    std::uint64_t heldTotal = 0;
+    std::vector<std::vector<PotreeNodePoints>> nodePoints;
+    for (int level = 0; level <= hierarchy.maxLevel(); ++level) {
+        nodePoints.emplace_back(hierarchy.nodeCount(level));
+        for (std::size_t i = 0; i < hierarchy.nodeCount(level); ++i) {
+            heldTotal += hierarchy.node(level, i).pointCount;
+        }
+    }
+
+    PotreeExportSummary summary;
+    {
+        AtomicFileWriter octree(target.file("octree.bin"));
+        std::vector<std::uint8_t> records;
+        std::uint64_t heldDone = 0;
+        const auto writeNode = [&](int level, std::size_t index,
+                                   std::span<const std::uint32_t> points) {
+            PotreeNodePoints& stored = nodePoints[static_cast<std::size_t>(level)][index];
+            stored.count = static_cast<std::uint32_t>(points.size());
+            stored.byteOffset = octree.bytesWritten();
+            records.resize(points.size() * recordBytes);
+            for (std::size_t p = 0; p < points.size(); ++p) {
+                encoder.encode(points[p], records.data() + p * recordBytes);
+            }
+            octree.write(records.data(), records.size());
+            summary.points += points.size();
+            heldDone += hierarchy.node(level, index).pointCount;
+            if (options.onProgress) {
+                options.onProgress(heldDone, heldTotal);
+            }
+            if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed)) {
+                throw PotreeExportCancelled(folder);
+            }
+        };
+        try {
+            visitAdditiveNodes(hierarchy, writeNode);
+        } catch (const NotNestedError& error) {
+            throw OutputError(folder + ": cannot store each point once: " + error.what());
+        }
+        summary.octreeBytes = octree.bytesWritten();
+        octree.commit();
+    }
+
+    const PotreeHierarchyFile layout =
+        layoutPotreeHierarchy(hierarchy, nodePoints, recordBytes, options.stepSize);
+    {
+        AtomicFileWriter file(target.file("hierarchy.bin"));
+        file.write(layout.bytes.data(), layout.bytes.size());
+        file.commit();
+    }
+    summary.nodes = layout.nodes;
+    summary.chunks = layout.chunks;
+    summary.depth = layout.depth;
+    // A node-order cloud (a loaded .omh) holds the parents' copies: its size is no input count.
+    summary.inputPoints = options.inputPoints > 0               ? options.inputPoints
+                          : cloud.order() == CloudOrder::Morton ? cloud.sortedEnd()
+                                                                : summary.points;
+    summary.droppedPoints =
+        summary.inputPoints > summary.points ? summary.inputPoints - summary.points : 0;
+    const double storeError =
+        cloud.storage() == PointStorage::Packed ? std::ldexp(1.0, -22) : std::ldexp(1.0, -25);
+    summary.positionTolerance = cube.edge * (storeError + std::ldexp(1.0, -30));
+
+    AtomicFileWriter metadata(target.file("metadata.json"));
+    metadata.write(metadataJson(options, summary, layout, geometry, encoder, options.stepSize));
     metadata.commit();
+    target.commit();
     return summary;
 }
 

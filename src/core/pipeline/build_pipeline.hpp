@@ -155,6 +155,9 @@ public:
     // cancelled, until the owner calls resetCancel() before starting the next one.
     void cancel();
     void resetCancel() { m_cancel.store(false); }
+    // The flag cancel() sets, for a job its owner runs beside the pipeline's own (an export of
+    // the kept hierarchy), so that one cancel() stops whichever runs.
+    const std::atomic<bool>& cancelFlag() const { return m_cancel; }
 
     // Called on the run's thread as the bounds pre-pass of a cloud file advances (see
     // OpenOptions::onPrePassProgress); it may call cancel(). progress() has the same numbers

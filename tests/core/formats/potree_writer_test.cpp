@@ -1,12 +1,16 @@
 // The Potree 2.0 export, read back as Potree's loader reads it: metadata.json's fields, the
 // hierarchy chunks (proxies followed into their chunks), each node's box by Potree's child
-// subdivision, every point decoded from octree.bin and checked against its node's box.
+// subdivision, every point decoded from octree.bin and checked against its node's box, and the
+// counts of an additive octree (each input point once). potree_roundtrip_test.cpp compares the
+// decoded points with the input; the CLI tests load the folder in a real Potree client.
 #include "formats/potree_writer.hpp"
 #include "hierarchy_test_support.hpp"
 #include "test_files.hpp"
 
+#include <atomic>
 #include <cstring>
 #include <deque>
+#include <filesystem>
 #include <gtest/gtest.h>
 #include <regex>
 
@@ -33,9 +37,9 @@ double numberField(const std::string& json, const std::string& pattern) {
 std::array<double, 3> tripleField(const std::string& json, const std::string& prefix) {
     const std::string number = R"(\s*([-+0-9.eE]+)\s*)";
     std::smatch match;
-    EXPECT_TRUE(std::regex_search(json, match,
-                                  std::regex(prefix + R"(\s*\[)" + number + "," + number + "," +
-                                             number + R"(\])")))
+    EXPECT_TRUE(std::regex_search(
+        json, match,
+        std::regex(prefix + R"(\s*\[)" + number + "," + number + "," + number + R"(\])")))
         << prefix;
     if (match.empty()) {
         return {};
@@ -67,7 +71,8 @@ struct PotreeNode {
     int level = 0;
 };
 
-void expectValidExport(const Hierarchy& hierarchy, const std::string& folder, int stepSize) {
+void expectValidExport(const Hierarchy& hierarchy, const std::string& folder, int stepSize,
+                       std::uint64_t droppedPoints = 0) {
     const std::string metadata = text(folder + "/metadata.json");
     const auto hierarchyBytes = readBytes(folder + "/hierarchy.bin");
     const auto octree = readBytes(folder + "/octree.bin");
@@ -80,6 +85,10 @@ void expectValidExport(const Hierarchy& hierarchy, const std::string& folder, in
     EXPECT_NE(metadata.find(R"("name": "position", "description": "", "size": 12, )"
                             R"("numElements": 3, "elementSize": 4, "type": "int32")"),
               std::string::npos);
+    // PotreeConverter's order for LAS input: position, intensity, ..., rgb.
+    if (rgb && intensity) {
+        EXPECT_LT(metadata.find(R"("name": "intensity")"), metadata.find(R"("name": "rgb")"));
+    }
     const std::size_t pointBytes = 12 + (rgb ? 6 : 0) + (intensity ? 2 : 0);
     const auto points = static_cast<std::uint64_t>(numberField(metadata, R"("points": (\d+))"));
     const auto firstChunk =
@@ -90,9 +99,13 @@ void expectValidExport(const Hierarchy& hierarchy, const std::string& folder, in
     Box root{tripleField(metadata, R"("min":)"), tripleField(metadata, R"("max":)")};
     const CubeTransform& cube = hierarchy.cloud().cube();
     for (int axis = 0; axis < 3; ++axis) {
-        EXPECT_DOUBLE_EQ(root.min[axis], cube.origin[axis] + hierarchy.cloud().sourceOffset()[axis]);
+        EXPECT_DOUBLE_EQ(root.min[axis],
+                         cube.origin[axis] + hierarchy.cloud().sourceOffset()[axis]);
         EXPECT_DOUBLE_EQ(root.max[axis] - root.min[axis], cube.edge);
+        // PotreeConverter: offset = the box minimum, spacing = edge / 128.
+        EXPECT_DOUBLE_EQ(offset[axis], root.min[axis]);
     }
+    EXPECT_DOUBLE_EQ(numberField(metadata, R"("spacing": ([-+0-9.eE]+))"), cube.edge / 128.0);
 
     // Potree's parseHierarchy, chunk by chunk: records in breadth-first order, children by
     // child index; a proxy's chunk starts with the proxy node itself.
@@ -130,7 +143,10 @@ void expectValidExport(const Hierarchy& hierarchy, const std::string& folder, in
             EXPECT_EQ(type == 1, childMask == 0);
             ++nodesPerLevel[node.level];
             pointSum += numPoints;
-            ASSERT_GT(numPoints, 0u);
+            // A subtree that stores no point is left out: every leaf written has points.
+            if (type == 1) {
+                ASSERT_GT(numPoints, 0u) << "level " << node.level;
+            }
             ASSERT_EQ(byteSize, std::uint64_t{numPoints} * pointBytes);
             ASSERT_LE(byteOffset + byteSize, octree.size());
             // Every point inside its node's box (the floor quantisation guarantees it).
@@ -138,7 +154,8 @@ void expectValidExport(const Hierarchy& hierarchy, const std::string& folder, in
             for (std::uint32_t p = 0; p < numPoints; ++p) {
                 const std::uint8_t* at = octree.data() + byteOffset + p * pointBytes;
                 for (int axis = 0; axis < 3; ++axis) {
-                    const double value = loadLe<std::int32_t>(at + 4 * axis) * scale[axis] + offset[axis];
+                    const double value =
+                        loadLe<std::int32_t>(at + 4 * axis) * scale[axis] + offset[axis];
                     ASSERT_GE(value, node.box.min[axis] - slack) << "level " << node.level;
                     ASSERT_LE(value, node.box.max[axis] + slack) << "level " << node.level;
                 }
@@ -152,15 +169,13 @@ void expectValidExport(const Hierarchy& hierarchy, const std::string& folder, in
         ASSERT_EQ(nodes.size(), chunk.chunkBytes / 22) << "records and announced nodes differ";
     }
     EXPECT_EQ(pointSum, points);
-    std::uint64_t heldPoints = 0;
+    // Additive: every input point once, less those the paper's leaf collapse dropped.
+    EXPECT_EQ(points, hierarchy.cloud().sortedEnd() - droppedPoints);
     for (int level = 0; level <= hierarchy.maxLevel(); ++level) {
-        EXPECT_EQ(nodesPerLevel[level], hierarchy.nodeCount(level)) << "level " << level;
-        for (std::size_t i = 0; i < hierarchy.nodeCount(level); ++i) {
-            heldPoints += hierarchy.node(level, i).pointCount;
-        }
+        EXPECT_LE(nodesPerLevel[level], hierarchy.nodeCount(level)) << "level " << level;
     }
-    EXPECT_EQ(points, heldPoints);
-    EXPECT_EQ(octree.size(), heldPoints * pointBytes);
+    EXPECT_EQ(nodesPerLevel[0], 1u);
+    EXPECT_EQ(octree.size(), points * pointBytes);
     if (hierarchy.maxLevel() > stepSize && hierarchy.nodeCount(stepSize + 1) > 0) {
         EXPECT_GT(proxies, 0u) << "deep hierarchies are split into chunks";
     }
@@ -188,14 +203,95 @@ TEST(PotreeExport, GeoreferencedScanWithColourAndIntensity) {
     options.maxLevel = 7;
     options.collapse = LeafCollapse::Paper;
     const BuildResult built = buildFile(path, options);
-    exportPotree(built.builder->hierarchy(), dir.file("autzen"));
-    expectValidExport(built.builder->hierarchy(), dir.file("autzen"), 4);
+    const PotreeExportSummary summary =
+        exportPotree(built.builder->hierarchy(), dir.file("autzen"));
+    const std::uint64_t dropped = built.builder->statistics().droppedPoints;
+    EXPECT_GT(dropped, 0u) << "the paper's collapse drops points of this scan at depth 7";
+    EXPECT_EQ(summary.droppedPoints, dropped);
+    EXPECT_EQ(summary.points + dropped, 110000u);
+    expectValidExport(built.builder->hierarchy(), dir.file("autzen"), 4, dropped);
+}
+
+// Leftovers of an export beside `folder`: its temporary folders (".NAME.tmp-XXXXXX").
+std::vector<std::string> temporaries(const std::filesystem::path& folder) {
+    std::vector<std::string> found;
+    for (const auto& entry : std::filesystem::directory_iterator(folder.parent_path())) {
+        const std::string name = entry.path().filename().string();
+        if (name.rfind("." + folder.filename().string() + ".tmp-", 0) == 0) {
+            found.push_back(name);
+        }
+    }
+    return found;
+}
+
+TEST(PotreeExport, CancelLeavesNothingBehind) {
+    TempDir dir;
+    BuildOptions options;
+    options.maxLevel = 5;
+    const BuildResult built = buildSynthetic(makeCloud(Shape::Random, 20000, 4), options);
+    std::atomic<bool> cancel{false};
+    PotreeExportOptions exportOptions;
+    exportOptions.cancel = &cancel;
+    std::uint64_t calls = 0, lastDone = 0, lastTotal = 0;
+    exportOptions.onProgress = [&](std::uint64_t done, std::uint64_t total) {
+        EXPECT_GE(done, lastDone);
+        lastDone = done;
+        lastTotal = total;
+        if (++calls == 10) {
+            cancel = true; // half-way: octree.bin is being written
+        }
+    };
+    const std::string folder = dir.file("potree");
+    EXPECT_THROW(exportPotree(built.builder->hierarchy(), folder, exportOptions),
+                 PotreeExportCancelled);
+    EXPECT_FALSE(std::filesystem::exists(folder));
+    EXPECT_TRUE(temporaries(folder).empty());
+    EXPECT_LT(lastDone, lastTotal);
+
+    // Uncancelled, progress ends at its total.
+    cancel = false;
+    calls = 0;
+    lastDone = 0;
+    exportOptions.cancel = nullptr;
+    exportPotree(built.builder->hierarchy(), folder, exportOptions);
+    EXPECT_EQ(lastDone, lastTotal);
+    EXPECT_TRUE(temporaries(folder).empty());
+}
+
+TEST(PotreeExport, ReplacesAnOldExportButNoOtherFolder) {
+    TempDir dir;
+    BuildOptions options;
+    options.maxLevel = 4;
+    const BuildResult small = buildSynthetic(makeCloud(Shape::Random, 3000, 1), options);
+    const BuildResult large = buildSynthetic(makeCloud(Shape::Random, 9000, 2), options);
+    const std::string folder = dir.file("potree");
+    exportPotree(small.builder->hierarchy(), folder);
+    exportPotree(large.builder->hierarchy(), folder); // an old export is replaced whole
+    EXPECT_NE(text(folder + "/metadata.json").find("\"points\": 9000"), std::string::npos);
+    EXPECT_TRUE(temporaries(folder).empty());
+
+    const std::string mine = dir.file("mine");
+    std::filesystem::create_directories(mine);
+    writeText(mine + "/notes.txt", "keep me");
+    try {
+        exportPotree(small.builder->hierarchy(), mine);
+        ADD_FAILURE() << "a folder with other files was replaced";
+    } catch (const OutputError& error) {
+        EXPECT_NE(std::string(error.what()).find("notes.txt"), std::string::npos) << error.what();
+        EXPECT_NE(std::string(error.what()).find(mine), std::string::npos) << error.what();
+    }
+    EXPECT_EQ(text(mine + "/notes.txt"), "keep me");
+    EXPECT_TRUE(temporaries(mine).empty());
+
+    writeText(dir.file("file"), "x");
+    EXPECT_THROW(exportPotree(small.builder->hierarchy(), dir.file("file")), OutputError);
+    EXPECT_THROW(exportPotree(small.builder->hierarchy(), dir.file("missing/sub")), OutputError);
 }
 
 TEST(PotreeExport, IncompleteHierarchyIsRefused) {
     TempDir dir;
-    const auto cloud = std::make_shared<SortedCloud>(CubeTransform{}, glm::dvec3(0.0),
-                                                     AttributeSet{}, 10);
+    const auto cloud =
+        std::make_shared<SortedCloud>(CubeTransform{}, glm::dvec3(0.0), AttributeSet{}, 10);
     Hierarchy hierarchy(cloud, 3);
     EXPECT_THROW(exportPotree(hierarchy, dir.file("p")), OutputError);
 }
