@@ -123,7 +123,7 @@ int runExportPotree(const std::vector<std::string>& args) {
     ProgressLine progress;
     bool first = true;
     options.onProgress = [&](std::uint64_t done, std::uint64_t total) {
-        progress.update("writing the Potree octree", done, total);
+        progress.update("writing the Potree octree (hierarchy records)", done, total);
         if (first) {
             first = false;
             pauseForTest();
