@@ -4,7 +4,8 @@
 // rasterizer (RenderMode::ComputePoints) on the same orbit. Baseline in the same run, per
 // path: the same frames with a budget of one node (clear, front, readback and the path's fixed
 // passes: what a frame costs without points), so ns_per_point isolates the points; a
-// phase=compare line per budget gives compute / points ratios. Needs a display (xvfb-run on
+// phase=compare line per budget gives compute / points ratios; phase=edl the same orbit with
+// and without eye-dome lighting. Needs a display (xvfb-run on
 // headless machines).
 #include "bench_timing.hpp"
 #include "cloud_view.hpp"
@@ -44,9 +45,10 @@ struct PathResult {
 // One orbit of `frames` frames around the cloud; every frame read back (grabFramebuffer), so
 // the GPU work is finished inside the timing.
 PathResult runPath(CloudView& view, const ViewCamera& start, int frames, RenderMode mode,
-                   std::size_t budget) {
+                   std::size_t budget, EdlMode edl = EdlMode::Off) {
     RenderSettings settings = view.renderSettings();
     settings.mode = mode;
+    settings.edl = edl;
     settings.pointBudget = budget;
     settings.uploadBudgetBytes = std::size_t{1} << 30; // measure drawing, not upload pacing
     view.setRenderSettings(settings);
@@ -155,5 +157,14 @@ int main(int argc, char** argv) {
                     ratio(results[1].frameMsMedian, results[0].frameMsMedian),
                     results[1].frameMsMedian < results[0].frameMsMedian ? "compute" : "points");
     }
+    // Eye-dome lighting: the same orbit with and without it (one full-screen pass reading
+    // nine depths a pixel), at the default budget.
+    const PathResult plain = runPath(view, start, frames, RenderMode::ComputePoints, 1'000'000);
+    const PathResult shaded =
+        runPath(view, start, frames, RenderMode::ComputePoints, 1'000'000, EdlMode::On);
+    std::printf("bench=render phase=edl path=compute point_budget=1000000 size=%dx%d frames=%d "
+                "frame_ms_median_off=%.2f frame_ms_median_on=%.2f edl_ms=%.2f\n",
+                width, height, frames, plain.frameMsMedian, shaded.frameMsMedian,
+                shaded.frameMsMedian - plain.frameMsMedian);
     return 0;
 }

@@ -20,6 +20,22 @@ constexpr std::pair<RenderMode, const char*> kRenderModes[] = {
     {RenderMode::Splats, "splats"},
 };
 
+// The eye-dome lighting combo's items, in the order of ui/buildpanel.ui.
+constexpr std::pair<EdlMode, const char*> kEdlModes[] = {
+    {EdlMode::Auto, "auto"},
+    {EdlMode::On, "on"},
+    {EdlMode::Off, "off"},
+};
+
+int edlModeIndex(EdlMode mode) {
+    for (int i = 0; i < static_cast<int>(std::size(kEdlModes)); ++i) {
+        if (kEdlModes[i].first == mode) {
+            return i;
+        }
+    }
+    return 0;
+}
+
 int renderModeIndex(RenderMode mode) {
     for (int i = 0; i < static_cast<int>(std::size(kRenderModes)); ++i) {
         if (kRenderModes[i].first == mode) {
@@ -53,6 +69,9 @@ BuildPanel::BuildPanel(QWidget* parent)
     connect(m_ui->thresholdSpin, &QDoubleSpinBox::valueChanged, this, viewEdited);
     connect(m_ui->budgetSpin, &QSpinBox::valueChanged, this, viewEdited);
     connect(m_ui->renderModeCombo, &QComboBox::currentIndexChanged, this, viewEdited);
+    connect(m_ui->edlCombo, &QComboBox::currentIndexChanged, this, viewEdited);
+    connect(m_ui->edlStrengthSpin, &QDoubleSpinBox::valueChanged, this, viewEdited);
+    connect(m_ui->edlRadiusSpin, &QDoubleSpinBox::valueChanged, this, viewEdited);
 }
 
 BuildPanel::~BuildPanel() = default;
@@ -96,6 +115,11 @@ ViewParameters BuildPanel::viewParameters() const {
     const int index = std::clamp(m_ui->renderModeCombo->currentIndex(), 0,
                                  static_cast<int>(std::size(kRenderModes)) - 1);
     parameters.renderMode = kRenderModes[index].first;
+    parameters.edl = kEdlModes[std::clamp(m_ui->edlCombo->currentIndex(), 0,
+                                          static_cast<int>(std::size(kEdlModes)) - 1)]
+                         .first;
+    parameters.edlStrength = static_cast<float>(m_ui->edlStrengthSpin->value());
+    parameters.edlRadiusPx = static_cast<float>(m_ui->edlRadiusSpin->value());
     return parameters;
 }
 
@@ -103,6 +127,9 @@ void BuildPanel::setViewParameters(const ViewParameters& parameters) {
     m_ui->thresholdSpin->setValue(parameters.projectionThresholdPx);
     m_ui->budgetSpin->setValue(static_cast<int>(parameters.pointBudget / 1000));
     m_ui->renderModeCombo->setCurrentIndex(renderModeIndex(parameters.renderMode));
+    m_ui->edlCombo->setCurrentIndex(edlModeIndex(parameters.edl));
+    m_ui->edlStrengthSpin->setValue(parameters.edlStrength);
+    m_ui->edlRadiusSpin->setValue(parameters.edlRadiusPx);
 }
 
 void BuildPanel::loadSettings(const QSettings& settings) {
@@ -135,6 +162,12 @@ void BuildPanel::loadSettings(const QSettings& settings) {
     if (modeName.isEmpty() && settings.value("view/splats", false).toBool()) {
         view.renderMode = RenderMode::Splats; // written by versions before the render mode
     }
+    const QString edlName = settings.value("view/edl").toString();
+    for (const auto& [mode, name] : kEdlModes) {
+        view.edl = edlName == QLatin1String(name) ? mode : view.edl;
+    }
+    view.edlStrength = settings.value("view/edlStrength", viewDefaults.edlStrength).toFloat();
+    view.edlRadiusPx = settings.value("view/edlRadiusPx", viewDefaults.edlRadiusPx).toFloat();
     setViewParameters(view);
 }
 
@@ -155,6 +188,9 @@ void BuildPanel::saveSettings(QSettings& settings) const {
     settings.setValue("view/renderMode",
                       QLatin1String(kRenderModes[renderModeIndex(view.renderMode)].second));
     settings.remove("view/splats");
+    settings.setValue("view/edl", QLatin1String(kEdlModes[edlModeIndex(view.edl)].second));
+    settings.setValue("view/edlStrength", view.edlStrength);
+    settings.setValue("view/edlRadiusPx", view.edlRadiusPx);
 }
 
 void BuildPanel::setBusy(bool busy) {

@@ -555,6 +555,9 @@ void MainWindow::applyViewParameters(const ViewParameters& parameters) {
     settings.projectionThresholdPx = parameters.projectionThresholdPx;
     settings.pointBudget = parameters.pointBudget;
     settings.mode = parameters.renderMode;
+    settings.edl = parameters.edl;
+    settings.edlStrength = parameters.edlStrength;
+    settings.edlRadiusPx = parameters.edlRadiusPx;
     m_view->setRenderSettings(settings);
 }
 

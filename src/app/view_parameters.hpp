@@ -1,5 +1,5 @@
 // The render parameters the build panel edits next to the build's: the front's projection
-// threshold, the per-frame point budget and the render mode. The main window maps them onto
+// threshold, the per-frame point budget, the render mode and eye-dome lighting. The main window maps them onto
 // CloudView's RenderSettings, so the panel needs no GL header (render_settings.hpp has none).
 #pragma once
 
@@ -14,6 +14,9 @@ struct ViewParameters {
     double projectionThresholdPx = 16.0;           // front: branch above, prune below
     std::size_t pointBudget = 1'000'000;           // most points drawn per frame
     RenderMode renderMode = RenderSettings{}.mode; // points, compute points or surface splats
+    EdlMode edl = RenderSettings{}.edl;            // eye-dome lighting
+    float edlStrength = RenderSettings{}.edlStrength;
+    float edlRadiusPx = RenderSettings{}.edlRadiusPx;
     friend bool operator==(const ViewParameters&, const ViewParameters&) = default;
 };
 

@@ -73,7 +73,9 @@ int runRender(const std::vector<std::string>& args) {
                                                            {"color", true},
                                                            {"depth", true},
                                                            {"threshold", true},
-                                                           {"threads", true}},
+                                                           {"threads", true},
+                                                           {"edl", false},
+                                                           {"no-edl", false}},
                                                           kMemoryOptionSpecs));
     if (parsed.help) {
         printCommandHelp(renderCommand());
@@ -124,6 +126,12 @@ int runRender(const std::vector<std::string>& args) {
                              *color + "'");
         }
     }
+    if (parsed.flag("edl") && parsed.flag("no-edl")) {
+        throw UsageError("--edl and --no-edl contradict each other: give one");
+    }
+    settings.edl = parsed.flag("edl") ? EdlMode::On
+                   : parsed.flag("no-edl") ? EdlMode::Off
+                                          : EdlMode::Auto;
     if (const auto threshold = parsed.value("threshold")) {
         settings.projectionThresholdPx =
             static_cast<double>(parseInteger(*threshold, "threshold", 1, 100000));
@@ -199,8 +207,8 @@ const Command& renderCommand() {
     static const Command command{
         "render", "build a cloud's hierarchy and save an image of it (needs a display)",
         "render IN OUT.png [--camera fit|iso|top|bottom|front|back|left|right] [--size WxH] "
-        "[--mode points|compute|splats] [--color rgb|normal|height|intensity|level|age] [--depth "
-        "N] "
+        "[--mode points|compute|splats] [--color rgb|normal|height|intensity|level|age] "
+        "[--edl|--no-edl] [--depth N] "
         "[--threshold PX] [--threads T] [--memory-budget SIZE] [--temp-dir DIR]",
         "Runs the pipeline (an unsorted cloud is sorted first; a .oms file is streamed; a .omh\n"
         "hierarchy is loaded), waits for the hierarchy, and renders it with the viewer's\n"
@@ -214,6 +222,8 @@ const Command& renderCommand() {
         "             surface splatting)\n"
         "  --color    rgb (default; height where the cloud has no colour), normal, height,\n"
         "             intensity, level (hierarchy level of each node), age (build order)\n"
+        "  --edl, --no-edl  eye-dome lighting on or off (default: on for clouds without\n"
+        "             colours, where it makes the shape readable)\n"
         "  --depth    hierarchy depth (default 7)\n"
         "  --threshold  front projection threshold in pixels: a node whose cell projects larger\n"
         "             is replaced by its children (default: the viewer's)\n"

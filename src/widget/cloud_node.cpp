@@ -303,6 +303,10 @@ void CloudNode::uploadPreview(QOpenGLExtraFunctions& gl) {
     m_previewVertices.clear();
 }
 
+bool CloudNode::hasColor() const {
+    return m_hierarchy && m_hierarchy->cloud().attributes().has(Attribute::Color);
+}
+
 int CloudNode::effectiveColorMode(const RenderSettings& settings) const {
     ColorMode mode = settings.color;
     if (m_hierarchy) {

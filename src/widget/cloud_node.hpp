@@ -47,6 +47,10 @@ public:
     // render() calls of one frame: a screenshot renders twice).
     FirstDrawTracker::Delays takeFirstDraws() { return m_firstDraws.take(); }
 
+    // Whether the cloud has colours of its own (unknown before a hierarchy: false), for
+    // EdlMode::Auto.
+    bool hasColor() const;
+
     // Whether RenderMode::ComputePoints runs the compute rasterizer in this context (else it
     // draws GL points).
     bool computePointsAvailable() const { return m_compute.available(); }

@@ -3,6 +3,7 @@
 #include "axis_gizmo_node.hpp"
 #include "build/hierarchy.hpp"
 #include "cloud_node.hpp"
+#include "edl_pass.hpp"
 #include "overlay_node.hpp"
 #include "sort/morton_sorter.hpp"
 #include "view_camera.hpp"
@@ -55,6 +56,7 @@ public:
     QPoint lastMouse;
     Qt::MouseButtons dragButtons;
     QMetaObject::Connection contextConnection;
+    EdlPass edl;
 
     CloudViewPrivate() {
         auto cloudNode = std::make_unique<CloudNode>();
@@ -78,6 +80,37 @@ public:
                     hierarchy->residency()->stats().pendingLoads > 0);
         }
         return false; // a preview changes only through setPreview(), which repaints
+    }
+
+    bool edlWanted() const {
+        switch (settings.edl) {
+        case EdlMode::On:
+            return true;
+        case EdlMode::Off:
+            return false;
+        case EdlMode::Auto:
+            return cloud->hierarchy() != nullptr && !cloud->hasColor();
+        }
+        return false;
+    }
+
+    // The scene into `framebuffer`; with eye-dome lighting, the cloud (node 0) first into
+    // the EDL target, shaded into the frame, and the overlays over it.
+    void renderScene(RenderContext& context, unsigned framebuffer) {
+        QOpenGLExtraFunctions& gl = *context.gl;
+        context.stats->eyeDomeLighting =
+            edlWanted() && edl.begin(gl, context.widthPx, context.heightPx, kBackground);
+        if (!context.stats->eyeDomeLighting) {
+            context.targetFramebuffer = framebuffer;
+            scene.render(context);
+            return;
+        }
+        context.targetFramebuffer = edl.framebuffer();
+        scene.render(context, 0, 1);
+        context.targetFramebuffer = framebuffer;
+        edl.composite(gl, framebuffer, context.projection, settings.edlStrength,
+                      settings.edlRadiusPx);
+        scene.render(context, 1, scene.size());
     }
 
     // Until the user navigates, the camera keeps framing the cloud as its known bounds grow
@@ -126,6 +159,7 @@ CloudView::~CloudView() {
     if (d->glReady && context() != nullptr) {
         makeCurrent();
         d->scene.releaseGL(*context()->extraFunctions());
+        d->edl.releaseGL(*context()->extraFunctions());
         doneCurrent();
     }
 }
@@ -285,6 +319,7 @@ void CloudView::initializeGL() {
     }
     try {
         d->scene.initializeGL(*glContext->extraFunctions());
+        d->edl.initializeGL();
         d->glReady = true;
     } catch (const std::exception& error) {
         d->glError = QString::fromStdString(error.what());
@@ -298,6 +333,7 @@ void CloudView::initializeGL() {
         if (d->glReady) {
             makeCurrent();
             d->scene.releaseGL(*context()->extraFunctions());
+            d->edl.releaseGL(*context()->extraFunctions());
             d->glReady = false;
             doneCurrent();
         }
@@ -339,7 +375,7 @@ FrameStats CloudView::renderFrame(unsigned framebuffer, int widthPx, int heightP
     renderContext.targetFramebuffer = framebuffer;
     renderContext.settle = settle;
     renderContext.stats = &stats;
-    d->scene.render(renderContext);
+    d->renderScene(renderContext, framebuffer);
     if (settle) {
         // A second pass draws what the first uploaded (the front converged in the first).
         gl.glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
@@ -347,7 +383,7 @@ FrameStats CloudView::renderFrame(unsigned framebuffer, int widthPx, int heightP
         gl.glDepthMask(GL_TRUE);
         gl.glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
         stats = FrameStats{};
-        d->scene.render(renderContext);
+        d->renderScene(renderContext, framebuffer);
     }
     const FirstDrawTracker::Delays firstDraws = d->cloud->takeFirstDraws();
     stats.leavesFirstDrawn = firstDraws.leaves;

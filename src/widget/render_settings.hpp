@@ -20,6 +20,10 @@ enum class RenderMode {
 
 enum class ColorMode { Rgb, Normal, Height, Intensity, Level, BuildAge };
 
+// Eye-dome lighting: Auto shades clouds without colours of their own (where the colour is a
+// height ramp and the shape is hard to read), as Potree does.
+enum class EdlMode { Auto, On, Off };
+
 enum class StandardView { Top, Bottom, Front, Back, Left, Right, Iso };
 
 struct RenderSettings {
@@ -38,6 +42,9 @@ struct RenderSettings {
     bool showOctreeCells = false;  // wireframe of the front's node cells
     bool showCutBoundary = true;   // highlight of the roots of the oblique cut
     bool showAxes = true;          // axis gizmo in the corner
+    EdlMode edl = EdlMode::Auto;
+    float edlStrength = 1.0f; // how dark an edge one log2 step of depth deep gets
+    float edlRadiusPx = 1.4f; // how far the neighbours it compares with are
     friend bool operator==(const RenderSettings&, const RenderSettings&) = default;
 };
 
@@ -55,6 +62,7 @@ struct FrameStats {
     std::size_t uploads = 0;       // node buffers uploaded this frame
     std::size_t gpuBytes = 0;      // node buffers resident on the GPU
     bool showingPreview = false;
+    bool eyeDomeLighting = false; // the frame was shaded with EDL
     // A hierarchy whose points are paged in on demand (a .omh beyond the memory budget):
     // node loads asked for and not done, before or after this frame's front evaluation (the
     // view keeps drawing while any is), and the points in memory against the budget.

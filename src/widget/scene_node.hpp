@@ -50,11 +50,14 @@ public:
             node->initializeGL(gl);
         }
     }
-    void render(RenderContext& context) {
-        for (auto& node : m_nodes) {
-            node->render(context);
+    void render(RenderContext& context) { render(context, 0, m_nodes.size()); }
+    // Nodes [first, end) only: a pass such as eye-dome lighting between them.
+    void render(RenderContext& context, std::size_t first, std::size_t end) {
+        for (std::size_t i = first; i < end && i < m_nodes.size(); ++i) {
+            m_nodes[i]->render(context);
         }
     }
+    std::size_t size() const { return m_nodes.size(); }
     void releaseGL(QOpenGLExtraFunctions& gl) {
         for (auto& node : m_nodes) {
             node->releaseGL(gl);

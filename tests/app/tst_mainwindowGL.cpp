@@ -19,6 +19,7 @@
 #include <QAction>
 #include <QComboBox>
 #include <QDir>
+#include <QDoubleSpinBox>
 #include <QElapsedTimer>
 #include <QFile>
 #include <QFileInfo>
@@ -359,11 +360,24 @@ void TestMainWindowGL::renderModeMenuAndPanelDriveTheView() {
         QCOMPARE(window.cloudView()->renderSettings().mode, RenderMode::ComputePoints);
         QCOMPARE(combo->currentText(), QStringLiteral("compute points"));
         pointsAction->trigger();
+
+        // Eye-dome lighting: auto by default; the panel turns it on and sets its shading.
+        auto* edl = window.buildPanel()->findChild<QComboBox*>(QStringLiteral("edlCombo"));
+        auto* strength =
+            window.buildPanel()->findChild<QDoubleSpinBox*>(QStringLiteral("edlStrengthSpin"));
+        QVERIFY(edl && strength);
+        QCOMPARE(window.cloudView()->renderSettings().edl, EdlMode::Auto);
+        edl->setCurrentIndex(edl->findText(QStringLiteral("on")));
+        strength->setValue(2.5);
+        QCOMPARE(window.cloudView()->renderSettings().edl, EdlMode::On);
+        QCOMPARE(window.cloudView()->renderSettings().edlStrength, 2.5f);
         window.close();
     }
     {
         MainWindow again;
         QCOMPARE(again.cloudView()->renderSettings().mode, RenderMode::Points);
+        QCOMPARE(again.cloudView()->renderSettings().edl, EdlMode::On);
+        QCOMPARE(again.cloudView()->renderSettings().edlStrength, 2.5f);
         again.close();
     }
     QSettings().remove(QStringLiteral("view/renderMode"));

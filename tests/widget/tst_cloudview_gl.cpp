@@ -99,6 +99,66 @@ private slots:
         QVERIFY(view.lastFrameStats().pointsDrawn > 0);
     }
 
+    // Eye-dome lighting darkens pixels behind their neighbours and never adds or removes one:
+    // the bunny (no colours) in every render mode, off against on; Auto shades it and not the
+    // coloured lion.
+    void eyeDomeLightingShadesAnUncolouredCloudAndKeepsItsCoverage() {
+        const QString bunny = test::sharedDataFile("bunny.ply");
+        const QString lion = test::sharedDataFile("lion.ply");
+        if (bunny.isEmpty() || lion.isEmpty()) {
+            QSKIP("../shared/data/bunny.ply or lion.ply is absent");
+        }
+        CloudView view;
+        view.setHierarchy(test::buildHierarchy(bunny, BuildOptions{}));
+        view.setStandardView(StandardView::Front);
+        for (const RenderMode mode :
+             {RenderMode::ComputePoints, RenderMode::Points, RenderMode::Splats}) {
+            RenderSettings settings = plainSettings();
+            settings.mode = mode;
+            settings.edl = EdlMode::Off;
+            view.setRenderSettings(settings);
+            const QImage plain = view.renderImage(QSize(400, 400));
+            QVERIFY(!view.lastFrameStats().eyeDomeLighting);
+            settings.edl = EdlMode::On;
+            view.setRenderSettings(settings);
+            const QImage shaded = view.renderImage(QSize(400, 400));
+            QVERIFY(view.lastFrameStats().eyeDomeLighting);
+            // The same pixels drawn (the background is cleared to one exact colour), darker
+            // where it changed, and changed on a good part of the cloud.
+            const QRgb background = plain.pixel(0, 0);
+            int drawn = 0, sameCoverage = 0, changed = 0, darker = 0;
+            for (int y = 0; y < plain.height(); ++y) {
+                for (int x = 0; x < plain.width(); ++x) {
+                    const QRgb a = plain.pixel(x, y), b = shaded.pixel(x, y);
+                    drawn += a != background ? 1 : 0;
+                    sameCoverage += (a != background) == (b != background) ? 1 : 0;
+                    if (a != b) {
+                        ++changed;
+                        darker += qGray(b) <= qGray(a) ? 1 : 0;
+                    }
+                }
+            }
+            const QString trace = QStringLiteral("mode %1: %2 drawn, %3 changed, %4 darker")
+                                      .arg(static_cast<int>(mode))
+                                      .arg(drawn)
+                                      .arg(changed)
+                                      .arg(darker);
+            QCOMPARE(shaded.pixel(0, 0), background);
+            QVERIFY2(drawn > 400 * 400 / 20, qPrintable(trace));
+            QVERIFY2(sameCoverage == 400 * 400, qPrintable(trace));
+            QVERIFY2(changed > drawn / 10, qPrintable(trace));
+            QVERIFY2(darker >= changed * 99 / 100, qPrintable(trace));
+        }
+        RenderSettings automatic = plainSettings();
+        QCOMPARE(automatic.edl, EdlMode::Auto);
+        view.setRenderSettings(automatic);
+        QVERIFY(!view.renderImage(QSize(200, 200)).isNull());
+        QVERIFY(view.lastFrameStats().eyeDomeLighting); // no colours: shaded
+        view.setHierarchy(test::buildHierarchy(lion, BuildOptions{}));
+        QVERIFY(!view.renderImage(QSize(200, 200)).isNull());
+        QVERIFY(!view.lastFrameStats().eyeDomeLighting); // colours of its own: as they are
+    }
+
     void lionRendersInColourAndAsSplats() {
         const QString path = test::sharedDataFile("lion.ply");
         if (path.isEmpty()) {
