@@ -31,6 +31,27 @@ namespace omicron {
 
 namespace {
 
+} // namespace
+
+QString pickedPointText(const PickedPoint& point) {
+    QString text = QStringLiteral("x %1  y %2  z %3")
+                       .arg(point.source.x, 0, 'f', 3)
+                       .arg(point.source.y, 0, 'f', 3)
+                       .arg(point.source.z, 0, 'f', 3);
+    if (point.hasColor) {
+        text += QStringLiteral(" · RGB %1 %2 %3")
+                    .arg(point.color.r)
+                    .arg(point.color.g)
+                    .arg(point.color.b);
+    }
+    if (point.hasIntensity) {
+        text += QStringLiteral(" · intensity %1").arg(point.intensity);
+    }
+    return text + QStringLiteral(" · level %1").arg(point.level);
+}
+
+namespace {
+
 QString mib(std::size_t bytes) {
     return QString::number(static_cast<double>(bytes) / 1048576.0, 'f', 0) + QStringLiteral(" MiB");
 }
@@ -49,6 +70,11 @@ MainWindow::MainWindow(QWidget* parent)
     m_fpsLabel = new QLabel(this);
     m_fpsLabel->setObjectName(QStringLiteral("fpsLabel"));
     m_memoryLabel = new QLabel(this);
+    m_pickLabel = new QLabel(this);
+    m_pickLabel->setObjectName(QStringLiteral("pickLabel"));
+    m_pickLabel->setToolTip(tr("The point under the cursor: its coordinates in the file's units "
+                               "(offsets included), colour, intensity and the level of the node "
+                               "that draws it"));
     m_progressBar = new QProgressBar(this);
     m_progressBar->setMaximum(1000);
     m_progressBar->setMaximumWidth(160);
@@ -60,6 +86,7 @@ MainWindow::MainWindow(QWidget* parent)
                               "changed (frames are drawn on demand)"));
     m_memoryLabel->setToolTip(tr("Resident memory of the process; for a saved hierarchy larger "
                                  "than the memory budget, also the points paged in of the budget"));
+    statusBar()->addPermanentWidget(m_pickLabel);
     statusBar()->addPermanentWidget(m_progressBar);
     statusBar()->addPermanentWidget(m_phaseLabel);
     statusBar()->addPermanentWidget(m_pointsLabel);
@@ -259,6 +286,10 @@ void MainWindow::connectActions() {
     }
     connect(m_ui->actionFlyMode, &QAction::toggled, m_view, &CloudView::setFlyMode);
     connect(m_view, &CloudView::flyModeChanged, m_ui->actionFlyMode, &QAction::setChecked);
+    m_view->setHoverPicking(true);
+    connect(m_view, &CloudView::pointHovered, this,
+            [this](const PickedPoint& point) { m_pickLabel->setText(pickedPointText(point)); });
+    connect(m_view, &CloudView::hoverLeftCloud, m_pickLabel, &QLabel::clear);
     connect(m_view, &CloudView::frameRendered, this, [this](const FrameStats& stats) {
         m_chartsPanel->setFrame(stats);
         m_cutPanel->setFrontNodes(stats.frontNodesPerLevel);

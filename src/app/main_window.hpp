@@ -32,6 +32,9 @@ class ChartsPanel;
 class CloudView;
 class CutPanel;
 
+// The status bar's text for the point under the cursor: "x … y … z … · RGB … · level …".
+QString pickedPointText(const PickedPoint& point);
+
 class MainWindow : public QMainWindow {
     Q_OBJECT
 public:
@@ -102,6 +105,7 @@ private:
     QLabel* m_pointsLabel = nullptr;
     QLabel* m_fpsLabel = nullptr;
     QLabel* m_memoryLabel = nullptr;
+    QLabel* m_pickLabel = nullptr; // the point under the cursor
     QProgressBar* m_progressBar = nullptr;
     QTimer m_statusTimer;
     std::size_t m_pointsDrawn = 0;

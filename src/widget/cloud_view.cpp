@@ -4,6 +4,7 @@
 #include "build/hierarchy.hpp"
 #include "cloud_node.hpp"
 #include "edl_pass.hpp"
+#include "front/front_pick.hpp"
 #include "overlay_node.hpp"
 #include "sort/morton_sorter.hpp"
 #include "view_camera.hpp"
@@ -57,6 +58,9 @@ public:
     Qt::MouseButtons dragButtons;
     QMetaObject::Connection contextConnection;
     EdlPass edl;
+    bool hoverPicking = false;
+    QTimer hoverTimer; // a pick once the pointer rests
+    QPoint hoverPosition;
 
     CloudViewPrivate() {
         auto cloudNode = std::make_unique<CloudNode>();
@@ -113,6 +117,57 @@ public:
         scene.render(context, 1, scene.size());
     }
 
+    struct SurfacePick {
+        glm::dvec3 position; // unit cube
+        double pixelSize;    // unit-cube length of one pixel at that depth
+    };
+
+    // The nearest depth the last frame drew within a few pixels of `position`, unprojected.
+    std::optional<SurfacePick> pickDepth(CloudView& view, const QPoint& position) {
+        if (!glReady) {
+            return std::nullopt;
+        }
+        const qreal ratio = view.devicePixelRatioF();
+        const int widthPx = std::max(1, static_cast<int>(std::lround(view.width() * ratio)));
+        const int heightPx = std::max(1, static_cast<int>(std::lround(view.height() * ratio)));
+        const int x = static_cast<int>(position.x() * ratio);
+        const int y = heightPx - 1 - static_cast<int>(position.y() * ratio);
+        view.makeCurrent();
+        QOpenGLExtraFunctions& gl = *view.context()->extraFunctions();
+        gl.glBindFramebuffer(GL_FRAMEBUFFER, view.defaultFramebufferObject());
+        // The nearest depth in a small window: points are sparse, a single pixel often misses.
+        constexpr int kRadius = 4;
+        const int x0 = std::clamp(x - kRadius, 0, widthPx - 1);
+        const int y0 = std::clamp(y - kRadius, 0, heightPx - 1);
+        const int w = std::min(2 * kRadius + 1, widthPx - x0);
+        const int h = std::min(2 * kRadius + 1, heightPx - y0);
+        std::vector<float> depths(static_cast<std::size_t>(w * h), 1.0f);
+        gl.glReadPixels(x0, y0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depths.data());
+        view.doneCurrent();
+        std::size_t best = 0;
+        for (std::size_t i = 1; i < depths.size(); ++i) {
+            if (depths[i] < depths[best]) {
+                best = i;
+            }
+        }
+        if (depths.empty() || depths[best] >= 1.0f) {
+            return std::nullopt;
+        }
+        const double px = x0 + static_cast<double>(best % static_cast<std::size_t>(w)) + 0.5;
+        const double py = y0 + static_cast<double>(best / static_cast<std::size_t>(w)) + 0.5;
+        const glm::dmat4 inverse =
+            glm::inverse(camera.projectionMatrix(static_cast<double>(widthPx) / heightPx) *
+                         camera.viewMatrix());
+        const auto unproject = [&](double sx, double sy) {
+            const glm::dvec4 world = inverse * glm::dvec4(sx / widthPx * 2.0 - 1.0,
+                                                          sy / heightPx * 2.0 - 1.0,
+                                                          depths[best] * 2.0 - 1.0, 1.0);
+            return glm::dvec3(world) / world.w;
+        };
+        const glm::dvec3 at = unproject(px, py);
+        return SurfacePick{at, glm::length(unproject(px + 1.0, py) - at)};
+    }
+
     // Until the user navigates, the camera keeps framing the cloud as its known bounds grow
     // (a build publishes the cloud in Morton order, one region after another).
     void applyAutoFit() {
@@ -127,6 +182,7 @@ CloudView::CloudView(QWidget* parent)
     : QOpenGLWidget(parent), d(std::make_unique<CloudViewPrivate>()) {
     qRegisterMetaType<omicron::FrameStats>();
     qRegisterMetaType<omicron::RenderSettings>();
+    qRegisterMetaType<omicron::PickedPoint>();
     QSurfaceFormat surfaceFormat = format();
     surfaceFormat.setVersion(3, 3);
     surfaceFormat.setProfile(QSurfaceFormat::CoreProfile);
@@ -151,6 +207,15 @@ CloudView::CloudView(QWidget* parent)
         update();
     });
     d->fpsClock.start();
+    d->hoverTimer.setSingleShot(true);
+    d->hoverTimer.setInterval(40);
+    connect(&d->hoverTimer, &QTimer::timeout, this, [this] {
+        if (const auto point = pickCloudPoint(d->hoverPosition)) {
+            emit pointHovered(*point);
+        } else {
+            emit hoverLeftCloud();
+        }
+    });
 }
 
 CloudView::~CloudView() {
@@ -449,45 +514,50 @@ QImage CloudView::renderImage(const QSize& size) {
 }
 
 std::optional<QVector3D> CloudView::pickPoint(const QPoint& position) {
-    if (!d->glReady) {
+    const auto picked = d->pickDepth(*this, position);
+    if (!picked) {
         return std::nullopt;
     }
-    const qreal ratio = devicePixelRatioF();
-    const int widthPx = std::max(1, static_cast<int>(std::lround(width() * ratio)));
-    const int heightPx = std::max(1, static_cast<int>(std::lround(height() * ratio)));
-    const int x = static_cast<int>(position.x() * ratio);
-    const int y = heightPx - 1 - static_cast<int>(position.y() * ratio);
-    makeCurrent();
-    QOpenGLExtraFunctions& gl = *context()->extraFunctions();
-    gl.glBindFramebuffer(GL_FRAMEBUFFER, defaultFramebufferObject());
-    // The nearest depth in a small window: points are sparse, a single pixel often misses.
-    constexpr int kRadius = 4;
-    const int x0 = std::clamp(x - kRadius, 0, widthPx - 1);
-    const int y0 = std::clamp(y - kRadius, 0, heightPx - 1);
-    const int w = std::min(2 * kRadius + 1, widthPx - x0);
-    const int h = std::min(2 * kRadius + 1, heightPx - y0);
-    std::vector<float> depths(static_cast<std::size_t>(w * h), 1.0f);
-    gl.glReadPixels(x0, y0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depths.data());
-    doneCurrent();
-    std::size_t best = 0;
-    for (std::size_t i = 1; i < depths.size(); ++i) {
-        if (depths[i] < depths[best]) {
-            best = i;
-        }
-    }
-    if (depths.empty() || depths[best] >= 1.0f) {
+    return QVector3D(static_cast<float>(picked->position.x), static_cast<float>(picked->position.y),
+                     static_cast<float>(picked->position.z));
+}
+
+std::optional<PickedPoint> CloudView::pickCloudPoint(const QPoint& position) {
+    const Front* front = d->cloud->front();
+    const auto& hierarchy = d->cloud->hierarchy();
+    if (front == nullptr || hierarchy == nullptr) {
         return std::nullopt;
     }
-    const double px = x0 + static_cast<double>(best % static_cast<std::size_t>(w)) + 0.5;
-    const double py = y0 + static_cast<double>(best / static_cast<std::size_t>(w)) + 0.5;
-    const glm::dvec4 ndc(px / widthPx * 2.0 - 1.0, py / heightPx * 2.0 - 1.0,
-                         depths[best] * 2.0 - 1.0, 1.0);
-    const glm::dmat4 inverse =
-        glm::inverse(d->camera.projectionMatrix(static_cast<double>(widthPx) / heightPx) *
-                     d->camera.viewMatrix());
-    const glm::dvec4 world = inverse * ndc;
-    return QVector3D(static_cast<float>(world.x / world.w), static_cast<float>(world.y / world.w),
-                     static_cast<float>(world.z / world.w));
+    const auto surface = d->pickDepth(*this, position);
+    if (!surface) {
+        return std::nullopt;
+    }
+    // A drawn point's disc covers a few pixels around it: search that far.
+    constexpr double kSearchPixels = 6.0;
+    const auto drawn = nearestDrawnPoint(*hierarchy, front->entries(), surface->position,
+                                         kSearchPixels * surface->pixelSize);
+    if (!drawn) {
+        return std::nullopt;
+    }
+    const SortedCloud& cloud = hierarchy->cloud();
+    PickedPoint point;
+    point.unitPosition = drawn->unitPosition;
+    point.source = cloud.cube().toSource(drawn->unitPosition);
+    point.level = morton::level(drawn->node);
+    point.cloudIndex = drawn->cloudIndex;
+    point.hasColor = cloud.attributes().has(Attribute::Color);
+    point.color = point.hasColor ? cloud.color(drawn->cloudIndex) : glm::u8vec3(0);
+    point.hasIntensity = cloud.attributes().has(Attribute::Intensity);
+    point.intensity = point.hasIntensity ? cloud.intensities()[drawn->cloudIndex] : 0;
+    return point;
+}
+
+void CloudView::setHoverPicking(bool on) {
+    d->hoverPicking = on;
+    setMouseTracking(on || hasMouseTracking());
+    if (!on) {
+        d->hoverTimer.stop();
+    }
 }
 
 void CloudView::mousePressEvent(QMouseEvent* event) {
@@ -515,10 +585,22 @@ void CloudView::mouseMoveEvent(QMouseEvent* event) {
             d->camera.orbit(delta.x(), delta.y());
         }
     } else {
+        if (d->hoverPicking) {
+            d->hoverPosition = position;
+            d->hoverTimer.start(); // picks when the pointer rests (reading depth costs a sync)
+        }
         return;
     }
     d->autoFit = false;
     update();
+}
+
+void CloudView::leaveEvent(QEvent* event) {
+    QOpenGLWidget::leaveEvent(event);
+    if (d->hoverPicking) {
+        d->hoverTimer.stop();
+        emit hoverLeftCloud();
+    }
 }
 
 void CloudView::mouseDoubleClickEvent(QMouseEvent* event) {

@@ -68,6 +68,14 @@ public:
     // depth of the last frame; nothing over empty space.
     std::optional<QVector3D> pickPoint(const QPoint& position);
 
+    // The drawn point of the cloud nearest to `position` (within a few pixels of what the
+    // last frame drew there), with its source coordinates and attributes; nothing over empty
+    // space or before a hierarchy is drawn.
+    std::optional<PickedPoint> pickCloudPoint(const QPoint& position);
+    // Hovering with no button pressed picks (after the pointer rests 40 ms) and emits
+    // pointHovered or hoverLeftCloud. Off by default; the app turns it on.
+    void setHoverPicking(bool on);
+
     // GL_RENDERER of the context (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"); empty before it exists.
     QString glRendererName() const;
 
@@ -82,6 +90,8 @@ signals:
     void frameRendered(const omicron::FrameStats& stats);
     void renderSettingsChanged(const omicron::RenderSettings& settings);
     void flyModeChanged(bool on);
+    void pointHovered(const omicron::PickedPoint& point);
+    void hoverLeftCloud();
 
 protected:
     void initializeGL() override;
@@ -90,6 +100,7 @@ protected:
     void mouseReleaseEvent(QMouseEvent* event) override;
     void mouseMoveEvent(QMouseEvent* event) override;
     void mouseDoubleClickEvent(QMouseEvent* event) override;
+    void leaveEvent(QEvent* event) override;
     void wheelEvent(QWheelEvent* event) override;
     void keyPressEvent(QKeyEvent* event) override;
     void keyReleaseEvent(QKeyEvent* event) override;

@@ -6,6 +6,8 @@
 #include <QMetaType>
 #include <array>
 #include <cstddef>
+#include <cstdint>
+#include <glm/vec3.hpp>
 
 namespace omicron {
 
@@ -78,7 +80,20 @@ struct FrameStats {
     double leafDrawDelayMaxMs = 0.0;
 };
 
+// A point of the cloud under the cursor (CloudView::pickCloudPoint): one the frame drew.
+struct PickedPoint {
+    glm::dvec3 source{0.0};      // in the file's coordinates and units (offsets included)
+    glm::vec3 unitPosition{0.0f}; // in the hierarchy's unit cube
+    int level = 0;               // of the node that drew it
+    std::uint32_t cloudIndex = 0;
+    bool hasColor = false;
+    glm::u8vec3 color{0};
+    bool hasIntensity = false;
+    std::uint16_t intensity = 0;
+};
+
 } // namespace omicron
 
 Q_DECLARE_METATYPE(omicron::RenderSettings)
+Q_DECLARE_METATYPE(omicron::PickedPoint)
 Q_DECLARE_METATYPE(omicron::FrameStats)

@@ -118,6 +118,32 @@ void TestMainWindowGL::openingASharedFileBuildsAndFillsThePanels() {
         QTRY_VERIFY_WITH_TIMEOUT(frontColumnMatchesTheView(window), kBuildTimeoutMs);
         QCOMPARE(window.cutPanel()->hierarchyModel()->rowCount(), 1);
         QCOMPARE(window.cutPanel()->hierarchyModel()->hierarchy(), window.service()->hierarchy());
+        // Hovering a drawn point names it in the status bar; leaving the view clears it.
+        auto* pickLabel = window.findChild<QLabel*>(QStringLiteral("pickLabel"));
+        QVERIFY(pickLabel != nullptr);
+        CloudView* view = window.cloudView();
+        QPoint onCloud(-1, -1);
+        for (int y = 0; y < view->height() && onCloud.x() < 0; y += 8) {
+            for (int x = 0; x < view->width() && onCloud.x() < 0; x += 8) {
+                if (view->pickCloudPoint(QPoint(x, y))) {
+                    onCloud = QPoint(x, y);
+                }
+            }
+        }
+        QVERIFY(onCloud.x() >= 0);
+        QMouseEvent move(QEvent::MouseMove, QPointF(onCloud), view->mapToGlobal(QPointF(onCloud)),
+                         Qt::NoButton, Qt::NoButton, Qt::NoModifier);
+        // The pointer itself over the view first (no window manager: X sends the enter and
+        // leave events a real pointer causes), then the move the view sees.
+        QTest::mouseMove(view, onCloud);
+        QTest::qWait(100);
+        QCoreApplication::sendEvent(view, &move);
+        QTRY_VERIFY(pickLabel->text().startsWith(QStringLiteral("x ")));
+        QVERIFY2(pickLabel->text().contains(QStringLiteral(" · level ")),
+                 qPrintable(pickLabel->text()));
+        QEvent leave(QEvent::Leave);
+        QCoreApplication::sendEvent(view, &leave);
+        QTRY_VERIFY(pickLabel->text().isEmpty());
         // With nothing left to refine the view stops drawing: the status bar says so rather
         // than an fps diluted by the pause; the next frame shows a rate again.
         auto* fpsLabel = window.findChild<QLabel*>(QStringLiteral("fpsLabel"));

@@ -9,6 +9,8 @@
 #include "widget_test_support.hpp"
 
 #include <QElapsedTimer>
+#include <QFile>
+#include <QTextStream>
 #include <QSignalSpy>
 #include <QTemporaryDir>
 #include <QtTest>
@@ -157,6 +159,71 @@ private slots:
         view.setHierarchy(test::buildHierarchy(lion, BuildOptions{}));
         QVERIFY(!view.renderImage(QSize(200, 200)).isNull());
         QVERIFY(!view.lastFrameStats().eyeDomeLighting); // colours of its own: as they are
+    }
+
+    // A pick at the pixel where a known point is drawn returns that point: a 20 x 20 grid of
+    // coloured points 1 m apart with a georeferenced offset, seen from above; over empty
+    // space, nothing. Hovering emits the same point.
+    void aPickAtAKnownPixelReturnsTheKnownPoint() {
+        QTemporaryDir dir;
+        const QString path = dir.filePath(QStringLiteral("grid.ply"));
+        {
+            QFile file(path);
+            QVERIFY(file.open(QIODevice::WriteOnly | QIODevice::Text));
+            QTextStream out(&file);
+            out << "ply\nformat ascii 1.0\nelement vertex 400\nproperty double x\n"
+                   "property double y\nproperty double z\nproperty uchar red\n"
+                   "property uchar green\nproperty uchar blue\nend_header\n";
+            out.setRealNumberPrecision(12);
+            for (int j = 0; j < 20; ++j) {
+                for (int i = 0; i < 20; ++i) {
+                    out << 500000.0 + i << ' ' << 4000000.0 + j << ' ' << 100.0 << ' ' << 10 * i
+                        << ' ' << 10 * j << " 200\n";
+                }
+            }
+        }
+        const auto hierarchy = test::buildHierarchy(path, BuildOptions{});
+        CloudView view;
+        view.setRenderSettings(plainSettings());
+        view.setHierarchy(hierarchy);
+        view.setStandardView(StandardView::Top);
+        view.resize(400, 400);
+        view.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&view));
+        QTRY_VERIFY(view.lastFrameStats().pointsDrawn == 400);
+        const auto pixelOf = [&](double x, double y, double z) {
+            const glm::dvec3 unit(hierarchy->cloud().cube().toUnit(glm::dvec3(x, y, z)));
+            const ViewCamera camera = view.camera();
+            const glm::dvec4 clip = camera.projectionMatrix(1.0) * camera.viewMatrix() *
+                                    glm::dvec4(unit, 1.0);
+            const glm::dvec3 ndc = glm::dvec3(clip) / clip.w;
+            return QPoint(static_cast<int>((ndc.x * 0.5 + 0.5) * view.width()),
+                          static_cast<int>((0.5 - ndc.y * 0.5) * view.height()));
+        };
+        for (const auto& [i, j] : {std::pair{7, 11}, std::pair{0, 0}, std::pair{19, 3}}) {
+            const auto picked = view.pickCloudPoint(pixelOf(500000.0 + i, 4000000.0 + j, 100.0));
+            QVERIFY2(picked.has_value(), qPrintable(QStringLiteral("grid point %1 %2").arg(i).arg(j)));
+            QVERIFY2(std::abs(picked->source.x - (500000.0 + i)) < 1e-3 &&
+                         std::abs(picked->source.y - (4000000.0 + j)) < 1e-3 &&
+                         std::abs(picked->source.z - 100.0) < 1e-3,
+                     qPrintable(QStringLiteral("grid point %1 %2 picked as %3 %4 %5")
+                                    .arg(i)
+                                    .arg(j)
+                                    .arg(picked->source.x, 0, 'f', 3)
+                                    .arg(picked->source.y, 0, 'f', 3)
+                                    .arg(picked->source.z, 0, 'f', 3)));
+            QVERIFY(picked->hasColor);
+            QCOMPARE(int(picked->color.r), 10 * i);
+            QCOMPARE(int(picked->color.g), 10 * j);
+            QVERIFY(picked->level >= 0);
+        }
+        QVERIFY(!view.pickCloudPoint(QPoint(2, 2)).has_value()); // the corner: background
+        QSignalSpy hovered(&view, &CloudView::pointHovered);
+        view.setHoverPicking(true);
+        QTest::mouseMove(&view, pixelOf(500007.0, 4000011.0, 100.0));
+        QTRY_COMPARE(hovered.count(), 1);
+        const auto point = hovered.first().at(0).value<PickedPoint>();
+        QVERIFY(std::abs(point.source.x - 500007.0) < 1e-3);
     }
 
     void lionRendersInColourAndAsSplats() {
