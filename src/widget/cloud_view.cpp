@@ -10,6 +10,7 @@
 #include "view_camera.hpp"
 
 #include <QElapsedTimer>
+#include <QPainter>
 #include <QKeyEvent>
 #include <QMouseEvent>
 #include <QOpenGLContext>
@@ -59,6 +60,11 @@ public:
     QMetaObject::Connection contextConnection;
     EdlPass edl;
     bool hoverPicking = false;
+    std::optional<MeasureKind> measureTool;
+    std::vector<Measurement> measurements;
+    std::optional<Measurement> draft; // the measurement being taken
+    QPoint pressPosition;
+    bool releaseEndsDoubleClick = false; // the release after a double-click adds no point
     QTimer hoverTimer; // a pick once the pointer rests
     QPoint hoverPosition;
 
@@ -115,6 +121,76 @@ public:
         edl.composite(gl, framebuffer, context.projection, settings.edlStrength,
                       settings.edlRadiusPx);
         scene.render(context, 1, scene.size());
+    }
+
+    // Each measurement's value beside it (QPainter over the frame: after the GL drawing).
+    void paintMeasurementLabels(CloudView& view) {
+        const auto& hierarchy = cloud->hierarchy();
+        if (hierarchy == nullptr || (measurements.empty() && !draft)) {
+            return;
+        }
+        const CubeTransform& cube = hierarchy->cloud().cube();
+        const glm::dmat4 viewProjection =
+            camera.projectionMatrix(static_cast<double>(view.width()) /
+                                    std::max(1, view.height())) *
+            camera.viewMatrix();
+        QPainter painter(&view);
+        painter.setRenderHint(QPainter::Antialiasing);
+        const QFontMetrics metrics(painter.font());
+        const auto label = [&](const Measurement& measurement) {
+            if (measurement.points.size() < 2) {
+                return;
+            }
+            // At the middle of the last segment (a distance: of the segment itself).
+            const glm::dvec3 middle =
+                (measurement.points[measurement.points.size() - 2] + measurement.points.back()) *
+                0.5;
+            const glm::dvec4 clip = viewProjection * glm::dvec4((middle - cube.origin) / cube.edge, 1.0);
+            if (clip.w <= 0.0) {
+                return; // behind the camera
+            }
+            const QPointF at((clip.x / clip.w * 0.5 + 0.5) * view.width(),
+                             (0.5 - clip.y / clip.w * 0.5) * view.height());
+            const QString text = measurement.valueText();
+            QRectF box(at + QPointF(6, -metrics.height() - 4),
+                       QSizeF(metrics.horizontalAdvance(text) + 8, metrics.height() + 4));
+            painter.fillRect(box, QColor(0, 0, 0, 170));
+            painter.setPen(QColor(255, 220, 40));
+            painter.drawText(box, Qt::AlignCenter, text);
+        };
+        for (const Measurement& measurement : measurements) {
+            label(measurement);
+        }
+        if (draft) {
+            label(*draft);
+        }
+    }
+
+    // The measurements (and the one being taken) as unit-cube polylines for the overlay.
+    void updateMeasurementLines() {
+        std::vector<std::vector<glm::dvec3>> lines;
+        const auto& hierarchy = cloud->hierarchy();
+        if (hierarchy != nullptr) {
+            const CubeTransform& cube = hierarchy->cloud().cube();
+            const auto add = [&](const Measurement& measurement) {
+                std::vector<glm::dvec3> line;
+                for (const glm::dvec3& p : measurement.points) {
+                    line.push_back((p - cube.origin) / cube.edge);
+                }
+                if (measurement.kind == MeasureKind::Area && measurement.complete() &&
+                    !line.empty()) {
+                    line.push_back(line.front());
+                }
+                lines.push_back(std::move(line));
+            };
+            for (const Measurement& measurement : measurements) {
+                add(measurement);
+            }
+            if (draft) {
+                add(*draft);
+            }
+        }
+        overlay->setMeasurementLines(std::move(lines));
     }
 
     struct SurfacePick {
@@ -428,6 +504,7 @@ FrameStats CloudView::renderFrame(unsigned framebuffer, int widthPx, int heightP
         d->camera.setSceneBox(d->cloud->boundsMin(), d->cloud->boundsMax());
     }
 
+    d->updateMeasurementLines();
     RenderContext renderContext;
     renderContext.gl = &gl;
     renderContext.camera = &d->camera;
@@ -463,6 +540,7 @@ void CloudView::paintGL() {
     const int widthPx = std::max(1, static_cast<int>(std::lround(width() * ratio)));
     const int heightPx = std::max(1, static_cast<int>(std::lround(height() * ratio)));
     FrameStats stats = renderFrame(defaultFramebufferObject(), widthPx, heightPx, false);
+    d->paintMeasurementLabels(*this);
 
     // Frames are drawn on demand: after a pause (no input, nothing to refine) a new window
     // starts with this frame, so the rate is that of rendering, not diluted by the idle time.
@@ -560,13 +638,93 @@ void CloudView::setHoverPicking(bool on) {
     }
 }
 
+void CloudView::setMeasureTool(std::optional<MeasureKind> tool) {
+    d->measureTool = tool;
+    if (d->draft) {
+        d->draft.reset();
+        emit measurementsChanged();
+    }
+    setCursor(tool ? Qt::CrossCursor : Qt::ArrowCursor);
+    update();
+}
+
+std::optional<MeasureKind> CloudView::measureTool() const {
+    return d->measureTool;
+}
+
+bool CloudView::addMeasurePoint(const QPoint& position) {
+    if (!d->measureTool) {
+        return false;
+    }
+    const auto point = pickCloudPoint(position); // snaps to the drawn point under the cursor
+    if (!point) {
+        return false;
+    }
+    if (!d->draft) {
+        d->draft = Measurement();
+        d->draft->kind = *d->measureTool;
+    }
+    d->draft->points.push_back(point->source);
+    if (d->draft->complete()) {
+        d->measurements.push_back(*d->draft);
+        d->draft.reset();
+    }
+    emit measurementsChanged();
+    update();
+    return true;
+}
+
+void CloudView::finishMeasurement() {
+    if (!d->draft || !d->draft->canFinish()) {
+        return;
+    }
+    d->draft->finish();
+    d->measurements.push_back(*d->draft);
+    d->draft.reset();
+    emit measurementsChanged();
+    update();
+}
+
+const std::vector<Measurement>& CloudView::measurements() const {
+    return d->measurements;
+}
+
+const Measurement* CloudView::measurementInProgress() const {
+    return d->draft ? &*d->draft : nullptr;
+}
+
+void CloudView::removeMeasurement(std::size_t index) {
+    if (index < d->measurements.size()) {
+        d->measurements.erase(d->measurements.begin() + static_cast<std::ptrdiff_t>(index));
+        emit measurementsChanged();
+        update();
+    }
+}
+
+void CloudView::clearMeasurements() {
+    if (!d->measurements.empty() || d->draft) {
+        d->measurements.clear();
+        d->draft.reset();
+        emit measurementsChanged();
+        update();
+    }
+}
+
 void CloudView::mousePressEvent(QMouseEvent* event) {
     d->lastMouse = event->position().toPoint();
+    d->pressPosition = d->lastMouse;
     d->dragButtons = event->buttons();
 }
 
 void CloudView::mouseReleaseEvent(QMouseEvent* event) {
     d->dragButtons = event->buttons();
+    const QPoint position = event->position().toPoint();
+    const bool click = (position - d->pressPosition).manhattanLength() <= 3;
+    if (d->releaseEndsDoubleClick) {
+        d->releaseEndsDoubleClick = false;
+    } else if (click && event->button() == Qt::LeftButton && d->measureTool) {
+        addMeasurePoint(position);
+    }
 }
 
 void CloudView::mouseMoveEvent(QMouseEvent* event) {
@@ -604,6 +762,11 @@ void CloudView::leaveEvent(QEvent* event) {
 }
 
 void CloudView::mouseDoubleClickEvent(QMouseEvent* event) {
+    if (d->measureTool) {
+        d->releaseEndsDoubleClick = true;
+        finishMeasurement(); // a polyline or an area ends at its last point
+        return;
+    }
     if (const auto picked = pickPoint(event->position().toPoint())) {
         d->camera.setPivot(glm::dvec3(picked->x(), picked->y(), picked->z()));
         d->autoFit = false;
@@ -646,6 +809,21 @@ void CloudView::keyPressEvent(QKeyEvent* event) {
     case Qt::Key_F:
         fitToCloud();
         return;
+    case Qt::Key_Return:
+    case Qt::Key_Enter:
+        if (d->draft) {
+            finishMeasurement();
+            return;
+        }
+        break;
+    case Qt::Key_Escape:
+        if (d->draft) {
+            d->draft.reset();
+            emit measurementsChanged();
+            update();
+            return;
+        }
+        break;
     default:
         QOpenGLWidget::keyPressEvent(event);
     }

@@ -6,6 +6,7 @@
 // Until the first sorted batch exists, a preview sample (the sorter's) can be shown instead.
 #pragma once
 
+#include "measurement.hpp"
 #include "render_settings.hpp"
 #include "view_camera.hpp"
 
@@ -13,6 +14,7 @@
 #include <QVector3D>
 #include <memory>
 #include <optional>
+#include <vector>
 
 namespace omicron {
 
@@ -76,6 +78,21 @@ public:
     // pointHovered or hoverLeftCloud. Off by default; the app turns it on.
     void setHoverPicking(bool on);
 
+    // The measure tool: while one is set, a click (press and release without moving) adds
+    // the cloud point under it to the measurement being taken; a distance or height is done
+    // at its second point, a polyline or area when finished (double-click, Enter). Escape
+    // drops the unfinished one. nullopt: navigation only (an unfinished one is dropped).
+    void setMeasureTool(std::optional<MeasureKind> tool);
+    std::optional<MeasureKind> measureTool() const;
+    // Adds the cloud point under `position` as a click does; false over empty space.
+    bool addMeasurePoint(const QPoint& position);
+    void finishMeasurement();
+    // The finished measurements, oldest first, and the one being taken (if any).
+    const std::vector<Measurement>& measurements() const;
+    const Measurement* measurementInProgress() const;
+    void removeMeasurement(std::size_t index);
+    void clearMeasurements();
+
     // GL_RENDERER of the context (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"); empty before it exists.
     QString glRendererName() const;
 
@@ -92,6 +109,8 @@ signals:
     void flyModeChanged(bool on);
     void pointHovered(const omicron::PickedPoint& point);
     void hoverLeftCloud();
+    // A measurement was added, removed or finished, or a point was added to the one taken.
+    void measurementsChanged();
 
 protected:
     void initializeGL() override;

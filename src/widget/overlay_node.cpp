@@ -16,6 +16,7 @@ constexpr std::uint8_t kBoxColor[4] = {200, 200, 200, 255};
 constexpr std::uint8_t kCutColor[4] = {255, 140, 0, 255};
 // The highlighted node: magenta, a colour no other overlay and no colour mode's ramp uses.
 constexpr std::uint8_t kHighlightColor[4] = {255, 0, 255, 255};
+constexpr std::uint8_t kMeasureColor[4] = {255, 220, 40, 255};
 
 } // namespace
 
@@ -94,6 +95,27 @@ void OverlayNode::render(RenderContext& context) {
         addBox(min, max, kHighlightColor);
         const glm::dvec3 grow = (max - min) * 0.005;
         addBox(min - grow, max + grow, kHighlightColor);
+    }
+    for (const std::vector<glm::dvec3>& polyline : m_measurements) {
+        const auto vertex = [&](const glm::dvec3& p) {
+            m_lines.push_back({static_cast<float>(p.x), static_cast<float>(p.y),
+                               static_cast<float>(p.z), kMeasureColor[0], kMeasureColor[1],
+                               kMeasureColor[2], kMeasureColor[3]});
+        };
+        for (std::size_t i = 1; i < polyline.size(); ++i) {
+            vertex(polyline[i - 1]);
+            vertex(polyline[i]);
+        }
+        // A cross at each picked point, a few thousandths of the cube across.
+        constexpr double kCross = 0.004;
+        for (const glm::dvec3& p : polyline) {
+            for (int axis = 0; axis < 3; ++axis) {
+                glm::dvec3 step(0.0);
+                step[axis] = kCross;
+                vertex(p - step);
+                vertex(p + step);
+            }
+        }
     }
     if (m_lines.empty()) {
         return;

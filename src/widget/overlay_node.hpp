@@ -7,6 +7,7 @@
 #include "scene_node.hpp"
 
 #include <QOpenGLShaderProgram>
+#include <glm/vec3.hpp>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -27,6 +28,11 @@ public:
     // The node whose cell is drawn as a box (a Morton code with its sentinel bit), or none.
     void setHighlight(std::optional<std::uint64_t> code) { m_highlight = code; }
     std::optional<std::uint64_t> highlight() const { return m_highlight; }
+    // Measurement polylines in the unit cube (closed ones end at their first point), drawn
+    // over the points like the highlight, with a cross at each vertex.
+    void setMeasurementLines(std::vector<std::vector<glm::dvec3>> polylines) {
+        m_measurements = std::move(polylines);
+    }
 
     struct LineVertex {
         float x, y, z;
@@ -38,6 +44,7 @@ private:
 
     const CloudNode& m_cloud;
     std::optional<std::uint64_t> m_highlight;
+    std::vector<std::vector<glm::dvec3>> m_measurements;
     std::vector<LineVertex> m_lines;
     std::unique_ptr<QOpenGLShaderProgram> m_program;
     unsigned m_vao = 0;

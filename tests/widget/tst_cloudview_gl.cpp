@@ -28,6 +28,36 @@ RenderSettings plainSettings() {
     return settings;
 }
 
+// A 20 x 20 grid of points 1 unit apart at x = 500000 + i, y = 4000000 + j (georeferenced
+// magnitudes), z = 100 + zPerColumn * i, coloured (10 i, 10 j, 200): an ASCII PLY at `path`.
+void writeGrid(const QString& path, double zPerColumn) {
+    QFile file(path);
+    QVERIFY(file.open(QIODevice::WriteOnly | QIODevice::Text));
+    QTextStream out(&file);
+    out << "ply\nformat ascii 1.0\nelement vertex 400\nproperty double x\n"
+           "property double y\nproperty double z\nproperty uchar red\n"
+           "property uchar green\nproperty uchar blue\nend_header\n";
+    out.setRealNumberPrecision(12);
+    for (int j = 0; j < 20; ++j) {
+        for (int i = 0; i < 20; ++i) {
+            out << 500000.0 + i << ' ' << 4000000.0 + j << ' ' << 100.0 + zPerColumn * i << ' '
+                << 10 * i << ' ' << 10 * j << " 200\n";
+        }
+    }
+}
+
+// Where the view draws the source point `p` of `hierarchy` (widget coordinates).
+QPoint pixelOf(const CloudView& view, const Hierarchy& hierarchy, const glm::dvec3& p) {
+    const glm::dvec3 unit(hierarchy.cloud().cube().toUnit(p));
+    const ViewCamera camera = view.camera();
+    const glm::dvec4 clip =
+        camera.projectionMatrix(static_cast<double>(view.width()) / view.height()) *
+        camera.viewMatrix() * glm::dvec4(unit, 1.0);
+    const glm::dvec3 ndc = glm::dvec3(clip) / clip.w;
+    return QPoint(static_cast<int>((ndc.x * 0.5 + 0.5) * view.width()),
+                  static_cast<int>((0.5 - ndc.y * 0.5) * view.height()));
+}
+
 PreviewSample spherePreview(std::size_t count) {
     PreviewSample preview;
     for (std::size_t i = 0; i < count; ++i) {
@@ -167,21 +197,7 @@ private slots:
     void aPickAtAKnownPixelReturnsTheKnownPoint() {
         QTemporaryDir dir;
         const QString path = dir.filePath(QStringLiteral("grid.ply"));
-        {
-            QFile file(path);
-            QVERIFY(file.open(QIODevice::WriteOnly | QIODevice::Text));
-            QTextStream out(&file);
-            out << "ply\nformat ascii 1.0\nelement vertex 400\nproperty double x\n"
-                   "property double y\nproperty double z\nproperty uchar red\n"
-                   "property uchar green\nproperty uchar blue\nend_header\n";
-            out.setRealNumberPrecision(12);
-            for (int j = 0; j < 20; ++j) {
-                for (int i = 0; i < 20; ++i) {
-                    out << 500000.0 + i << ' ' << 4000000.0 + j << ' ' << 100.0 << ' ' << 10 * i
-                        << ' ' << 10 * j << " 200\n";
-                }
-            }
-        }
+        writeGrid(path, 0.0);
         const auto hierarchy = test::buildHierarchy(path, BuildOptions{});
         CloudView view;
         view.setRenderSettings(plainSettings());
@@ -191,17 +207,9 @@ private slots:
         view.show();
         QVERIFY(QTest::qWaitForWindowExposed(&view));
         QTRY_VERIFY(view.lastFrameStats().pointsDrawn == 400);
-        const auto pixelOf = [&](double x, double y, double z) {
-            const glm::dvec3 unit(hierarchy->cloud().cube().toUnit(glm::dvec3(x, y, z)));
-            const ViewCamera camera = view.camera();
-            const glm::dvec4 clip = camera.projectionMatrix(1.0) * camera.viewMatrix() *
-                                    glm::dvec4(unit, 1.0);
-            const glm::dvec3 ndc = glm::dvec3(clip) / clip.w;
-            return QPoint(static_cast<int>((ndc.x * 0.5 + 0.5) * view.width()),
-                          static_cast<int>((0.5 - ndc.y * 0.5) * view.height()));
-        };
         for (const auto& [i, j] : {std::pair{7, 11}, std::pair{0, 0}, std::pair{19, 3}}) {
-            const auto picked = view.pickCloudPoint(pixelOf(500000.0 + i, 4000000.0 + j, 100.0));
+            const auto picked = view.pickCloudPoint(
+                pixelOf(view, *hierarchy, glm::dvec3(500000.0 + i, 4000000.0 + j, 100.0)));
             QVERIFY2(picked.has_value(), qPrintable(QStringLiteral("grid point %1 %2").arg(i).arg(j)));
             QVERIFY2(std::abs(picked->source.x - (500000.0 + i)) < 1e-3 &&
                          std::abs(picked->source.y - (4000000.0 + j)) < 1e-3 &&
@@ -220,10 +228,89 @@ private slots:
         QVERIFY(!view.pickCloudPoint(QPoint(2, 2)).has_value()); // the corner: background
         QSignalSpy hovered(&view, &CloudView::pointHovered);
         view.setHoverPicking(true);
-        QTest::mouseMove(&view, pixelOf(500007.0, 4000011.0, 100.0));
+        QTest::mouseMove(&view, pixelOf(view, *hierarchy, glm::dvec3(500007.0, 4000011.0, 100.0)));
         QTRY_COMPARE(hovered.count(), 1);
         const auto point = hovered.first().at(0).value<PickedPoint>();
         QVERIFY(std::abs(point.source.x - 500007.0) < 1e-3);
+    }
+
+    // The measure tool: clicks on drawn points of the grid (z rising by 0.5 per column) give
+    // the distance, height difference, polyline length and horizontal area of those points.
+    void measurementsBetweenPickedPointsAreTheirGeometry() {
+        QTemporaryDir dir;
+        const QString path = dir.filePath(QStringLiteral("grid.ply"));
+        writeGrid(path, 0.5);
+        const auto hierarchy = test::buildHierarchy(path, BuildOptions{});
+        CloudView view;
+        view.setRenderSettings(plainSettings());
+        view.setHierarchy(hierarchy);
+        view.setStandardView(StandardView::Top);
+        view.resize(400, 400);
+        view.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&view));
+        QTRY_VERIFY(view.lastFrameStats().pointsDrawn == 400);
+        const auto grid = [](int i, int j) {
+            return glm::dvec3(500000.0 + i, 4000000.0 + j, 100.0 + 0.5 * i);
+        };
+        const auto click = [&](int i, int j) {
+            QTest::mouseClick(&view, Qt::LeftButton, {}, pixelOf(view, *hierarchy, grid(i, j)));
+        };
+        // Positions are float in the unit cube: a 19-unit cube keeps them to about 2e-6.
+        constexpr double kTolerance = 1e-4;
+        QSignalSpy changed(&view, &CloudView::measurementsChanged);
+        click(0, 0); // no tool: navigation only
+        QVERIFY(view.measurements().empty());
+
+        view.setMeasureTool(MeasureKind::Distance);
+        click(0, 0);
+        QVERIFY(view.measurementInProgress() != nullptr);
+        click(5, 12);
+        QCOMPARE(view.measurements().size(), std::size_t{1});
+        QVERIFY(std::abs(view.measurements()[0].value() - glm::length(grid(5, 12) - grid(0, 0))) <
+                1e-6);
+
+        view.setMeasureTool(MeasureKind::Height);
+        click(2, 3);
+        click(6, 3);
+        QCOMPARE(view.measurements().size(), std::size_t{2});
+        QVERIFY(std::abs(view.measurements()[1].value() - 2.0) < kTolerance);
+
+        view.setMeasureTool(MeasureKind::Polyline);
+        click(0, 0);
+        click(3, 4);
+        click(3, 10);
+        QCOMPARE(view.measurements().size(), std::size_t{2}); // open until finished
+        QTest::keyClick(&view, Qt::Key_Return);
+        QCOMPARE(view.measurements().size(), std::size_t{3});
+        const double polyline =
+            glm::length(grid(3, 4) - grid(0, 0)) + glm::length(grid(3, 10) - grid(3, 4));
+        QVERIFY(std::abs(view.measurements()[2].value() - polyline) < kTolerance);
+
+        view.setMeasureTool(MeasureKind::Area);
+        click(0, 0);
+        click(10, 0);
+        click(10, 10);
+        click(0, 10);
+        view.finishMeasurement();
+        QCOMPARE(view.measurements().size(), std::size_t{4});
+        QVERIFY2(std::abs(view.measurements()[3].value() - 100.0) < kTolerance,
+                 qPrintable(view.measurements()[3].valueText() + QStringLiteral(" from %1 points").arg(view.measurements()[3].points.size())));
+        QVERIFY(view.measurements()[3].valueText().startsWith(QStringLiteral("100.000")));
+
+        // Over empty space a click adds nothing; Escape drops an unfinished one.
+        QVERIFY(!view.addMeasurePoint(QPoint(2, 2)));
+        click(1, 1);
+        QVERIFY(view.measurementInProgress() != nullptr);
+        QTest::keyClick(&view, Qt::Key_Escape);
+        QVERIFY(view.measurementInProgress() == nullptr);
+        view.removeMeasurement(0);
+        QCOMPARE(view.measurements().size(), std::size_t{3});
+        QVERIFY(changed.count() >= 10);
+        // The lines and labels are drawn: the frame changes where they are.
+        const QImage with = view.grabFramebuffer();
+        view.clearMeasurements();
+        const QImage without = view.grabFramebuffer();
+        QVERIFY(with != without);
     }
 
     void lionRendersInColourAndAsSplats() {
