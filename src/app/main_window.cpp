@@ -5,6 +5,7 @@
 #include "charts_panel.hpp"
 #include "cloud_view.hpp"
 #include "cut_panel.hpp"
+#include "measurements_panel.hpp"
 #include "memory_budget.hpp"
 #include "ui_mainwindow.h"
 
@@ -24,7 +25,10 @@
 #include <QMimeData>
 #include <QProgressBar>
 #include <QScreen>
+#include <QScrollArea>
+#include <QScrollBar>
 #include <QSettings>
+#include <QToolBar>
 #include <QUrl>
 
 namespace omicron {
@@ -123,7 +127,15 @@ void MainWindow::createDocks() {
                              Qt::DockWidgetArea area) {
         auto* widget = new QDockWidget(title, this);
         widget->setObjectName(name); // saveState() keys docks by object name
-        widget->setWidget(panel);
+        // In a scroll area: a panel's form never makes the window taller than the screen.
+        auto* scroll = new QScrollArea(widget);
+        scroll->setWidgetResizable(true);
+        scroll->setFrameShape(QFrame::NoFrame);
+        scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff); // as wide as the panel
+        scroll->setWidget(panel);
+        scroll->setMinimumWidth(panel->minimumSizeHint().width() +
+                                scroll->verticalScrollBar()->sizeHint().width());
+        widget->setWidget(scroll);
         addDockWidget(area, widget);
         QAction* toggle = widget->toggleViewAction();
         m_ui->menuPanels->addAction(toggle);
@@ -138,6 +150,11 @@ void MainWindow::createDocks() {
     dock(m_buildPanel, tr("Build"), QStringLiteral("buildDock"), Qt::LeftDockWidgetArea);
     dock(m_cutPanel, tr("Cut progress"), QStringLiteral("cutDock"), Qt::RightDockWidgetArea);
     dock(m_chartsPanel, tr("Charts"), QStringLiteral("chartsDock"), Qt::BottomDockWidgetArea);
+    m_measurementsPanel = new MeasurementsPanel(this);
+    QDockWidget* measurements = dock(m_measurementsPanel, tr("Measurements"),
+                                     QStringLiteral("measurementsDock"), Qt::BottomDockWidgetArea);
+    tabifyDockWidget(findChild<QDockWidget*>(QStringLiteral("chartsDock")), measurements);
+    findChild<QDockWidget*>(QStringLiteral("chartsDock"))->raise();
     m_ui->menuPanels->actions().at(0)->setShortcut(QKeySequence(tr("Ctrl+Shift+B")));
     m_ui->menuPanels->actions().at(1)->setShortcut(QKeySequence(tr("Ctrl+Shift+U")));
     m_ui->menuPanels->actions().at(2)->setShortcut(QKeySequence(tr("Ctrl+Shift+C")));
@@ -286,6 +303,7 @@ void MainWindow::connectActions() {
     }
     connect(m_ui->actionFlyMode, &QAction::toggled, m_view, &CloudView::setFlyMode);
     connect(m_view, &CloudView::flyModeChanged, m_ui->actionFlyMode, &QAction::setChecked);
+    createMeasureTools();
     m_view->setHoverPicking(true);
     connect(m_view, &CloudView::pointHovered, this,
             [this](const PickedPoint& point) { m_pickLabel->setText(pickedPointText(point)); });
@@ -297,6 +315,63 @@ void MainWindow::connectActions() {
         m_lastFrameStats = stats;
         m_lastFrame.start();
     });
+}
+
+void MainWindow::createMeasureTools() {
+    // The Measure menu and toolbar: one tool at a time, Navigate for none (M: distance).
+    QMenu* menu = new QMenu(tr("&Measure"), this);
+    menuBar()->insertMenu(m_ui->menuHelp->menuAction(), menu);
+    QToolBar* toolbar = addToolBar(tr("Measure"));
+    toolbar->setObjectName(QStringLiteral("measureToolbar"));
+    auto* group = new QActionGroup(this);
+    const auto tool = [&](const QString& text, const QString& name, std::optional<MeasureKind> kind,
+                          const QKeySequence& shortcut, const QString& tip) {
+        QAction* action = menu->addAction(text);
+        action->setObjectName(name);
+        action->setCheckable(true);
+        action->setShortcut(shortcut);
+        action->setToolTip(tip);
+        group->addAction(action);
+        toolbar->addAction(action);
+        connect(action, &QAction::triggered, this, [this, kind] {
+            m_view->setMeasureTool(kind);
+            if (kind) {
+                statusBar()->showMessage(
+                    tr("Measuring: click points on the cloud%1; Esc drops the unfinished one")
+                        .arg(Measurement::fixedPoints(*kind) == 0
+                                 ? tr(", double-click or Enter to finish")
+                                 : QString()),
+                    8000);
+            }
+        });
+        return action;
+    };
+    tool(tr("&Navigate"), QStringLiteral("actionNavigate"), std::nullopt, QKeySequence(tr("N")),
+         tr("Orbit, pan and zoom; clicks measure nothing"))
+        ->setChecked(true);
+    tool(tr("&Distance"), QStringLiteral("actionMeasureDistance"), MeasureKind::Distance,
+         QKeySequence(tr("M")), tr("Distance between two picked points"));
+    tool(tr("&Height Difference"), QStringLiteral("actionMeasureHeight"), MeasureKind::Height,
+         QKeySequence(), tr("Height of the second picked point above the first"));
+    tool(tr("&Polyline Length"), QStringLiteral("actionMeasurePolyline"), MeasureKind::Polyline,
+         QKeySequence(), tr("Length of a polyline through picked points"));
+    tool(tr("Horizontal &Area"), QStringLiteral("actionMeasureArea"), MeasureKind::Area,
+         QKeySequence(), tr("Area of the polygon through picked points, projected on the "
+                            "horizontal plane"));
+    menu->addSeparator();
+    QAction* clear = menu->addAction(tr("&Clear Measurements"));
+    connect(clear, &QAction::triggered, m_view, &CloudView::clearMeasurements);
+    connect(m_view, &CloudView::measurementsChanged, this,
+            [this] { m_measurementsPanel->setMeasurements(m_view->measurements()); });
+    connect(m_measurementsPanel, &MeasurementsPanel::removeRequested, this,
+            [this](const std::vector<std::size_t>& indices) {
+                for (const std::size_t index : indices) { // descending: indices stay valid
+                    m_view->removeMeasurement(index);
+                }
+            });
+    connect(m_measurementsPanel, &MeasurementsPanel::clearRequested, m_view,
+            &CloudView::clearMeasurements);
+    connect(m_measurementsPanel, &MeasurementsPanel::exportFailed, this, &MainWindow::showError);
 }
 
 void MainWindow::connectService() {

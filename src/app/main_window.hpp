@@ -29,6 +29,7 @@ namespace omicron {
 class BuilderService;
 class BuildPanel;
 class ChartsPanel;
+class MeasurementsPanel;
 class CloudView;
 class CutPanel;
 
@@ -47,6 +48,7 @@ public:
     BuildPanel* buildPanel() const { return m_buildPanel; }
     CutPanel* cutPanel() const { return m_cutPanel; }
     ChartsPanel* chartsPanel() const { return m_chartsPanel; }
+    MeasurementsPanel* measurementsPanel() const { return m_measurementsPanel; }
     // The central CloudView.
     CloudView* cloudView() const { return m_view; }
     QStringList recentFiles() const { return m_recentFiles; }
@@ -80,6 +82,7 @@ private:
     void connectActions();
     void connectService();
     void loadSettings();
+    void createMeasureTools();
     void saveSettings() const;
     void addRecentFile(const QString& path);
     void updateRecentMenu();
@@ -98,6 +101,7 @@ private:
     BuildPanel* m_buildPanel = nullptr;
     CutPanel* m_cutPanel = nullptr;
     ChartsPanel* m_chartsPanel = nullptr;
+    MeasurementsPanel* m_measurementsPanel = nullptr;
     QStringList m_recentFiles;
     QString m_title; // what is shown: file name or "generated scene"
     PipelineProgress m_progress;

@@ -610,8 +610,9 @@ std::optional<PickedPoint> CloudView::pickCloudPoint(const QPoint& position) {
     if (!surface) {
         return std::nullopt;
     }
-    // A drawn point's disc covers a few pixels around it: search that far.
-    constexpr double kSearchPixels = 6.0;
+    // A drawn point's disc may cover many pixels around it (a coarse node's splats are large):
+    // search that far; the nearest point wins.
+    constexpr double kSearchPixels = 32.0;
     const auto drawn = nearestDrawnPoint(*hierarchy, front->entries(), surface->position,
                                          kSearchPixels * surface->pixelSize);
     if (!drawn) {

@@ -11,6 +11,7 @@
 #include "hierarchy_model.hpp"
 #include "level_model.hpp"
 #include "main_window.hpp"
+#include "measurements_panel.hpp"
 #include "memory_budget.hpp"
 #include "time_series_chart.hpp"
 #include "widget_test_support.hpp"
@@ -32,7 +33,9 @@
 #include <QMessageBox>
 #include <QSettings>
 #include <QSignalSpy>
+#include <QPushButton>
 #include <QSpinBox>
+#include <QTableWidget>
 #include <QStandardPaths>
 #include <QSurfaceFormat>
 #include <QTemporaryDir>
@@ -144,6 +147,34 @@ void TestMainWindowGL::openingASharedFileBuildsAndFillsThePanels() {
         QEvent leave(QEvent::Leave);
         QCoreApplication::sendEvent(view, &leave);
         QTRY_VERIFY(pickLabel->text().isEmpty());
+
+        // Measure → Distance, two clicks on the cloud: the Measurements dock lists it; its
+        // Delete button removes it from the view.
+        auto* distance = window.findChild<QAction*>(QStringLiteral("actionMeasureDistance"));
+        QVERIFY(distance != nullptr);
+        distance->trigger();
+        QCOMPARE(view->measureTool(), std::optional<MeasureKind>(MeasureKind::Distance));
+        QPoint second(-1, -1);
+        for (int y = view->height() - 1; y >= 0 && second.x() < 0; y -= 8) {
+            for (int x = view->width() - 1; x >= 0 && second.x() < 0; x -= 8) {
+                if (view->pickCloudPoint(QPoint(x, y))) {
+                    second = QPoint(x, y);
+                }
+            }
+        }
+        QVERIFY(view->addMeasurePoint(onCloud));
+        QVERIFY(view->addMeasurePoint(second));
+        QCOMPARE(view->measurements().size(), std::size_t{1});
+        QTableWidget* measured = window.measurementsPanel()->table();
+        QCOMPARE(measured->rowCount(), 1);
+        QCOMPARE(measured->item(0, 2)->text(), view->measurements()[0].valueText());
+        measured->selectRow(0);
+        window.measurementsPanel()->findChild<QPushButton*>(QStringLiteral("deleteMeasurements"))
+            ->click();
+        QVERIFY(view->measurements().empty());
+        QCOMPARE(measured->rowCount(), 0);
+        window.findChild<QAction*>(QStringLiteral("actionNavigate"))->trigger();
+        QVERIFY(!view->measureTool().has_value());
         // With nothing left to refine the view stops drawing: the status bar says so rather
         // than an fps diluted by the pause; the next frame shows a rate again.
         auto* fpsLabel = window.findChild<QLabel*>(QStringLiteral("fpsLabel"));

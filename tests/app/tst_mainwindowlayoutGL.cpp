@@ -90,6 +90,9 @@ void TestMainWindowLayoutGL::panelsReadAtAGlanceAfterABuild() {
     window.applyDefaultDockSizes(size);
     window.show();
     QVERIFY(QTest::qWaitForWindowExposed(&window));
+    // The panels' minimum sizes fit the window: it stays the size asked for.
+    QVERIFY2(window.width() <= size.width() && window.height() <= size.height(),
+             qPrintable(QStringLiteral("%1x%2").arg(window.width()).arg(window.height())));
     QSignalSpy finished(window.service(), &BuilderService::buildFinished);
     window.openFile(path);
     QTRY_VERIFY_WITH_TIMEOUT(finished.count() == 1, kBuildTimeoutMs);
