@@ -31,6 +31,8 @@ uniform float u_sizeScale;
 uniform float u_minPointPx;
 uniform float u_maxPointPx;
 uniform ivec2 u_viewportPx;
+uniform bool u_clipEnabled;
+uniform mat4 u_clip; // unit cube -> clip box frame, inside = [-1, 1]^3
 uniform uint u_pointCount; // invocations of this dispatch: the points of its nodes
 uniform uint u_nodeBase;   // its nodes in the draw table (followed by a sentinel entry)
 uniform uint u_chunkBase;  // its workgroups in the chunk table
@@ -90,8 +92,13 @@ vec3 decodeNormal(uint bits) {
     return max(vec3(c) / 511.0, vec3(-1.0)); // the GL 4.2 rule for signed normalised values
 }
 
-// As points.vert: false when the point is clipped (behind the eye, outside near/far).
+// As points.vert: false when the point is clipped (outside the clip box, behind the eye,
+// outside near/far).
 bool projectPoint(PointVertex p, out Footprint footprint) {
+    if (u_clipEnabled &&
+        any(greaterThan(abs((u_clip * vec4(p.position, 1.0)).xyz), vec3(1.0)))) {
+        return false; // outside the clip box
+    }
     vec4 clip = u_viewProjection * vec4(p.position, 1.0);
     if (clip.w <= 0.0) {
         return false;

@@ -12,12 +12,23 @@ uniform float u_sizeScale;
 uniform float u_minPointPx;
 uniform float u_maxPointPx;
 uniform float u_depthOffset; // splat visibility pass: push splats back by this many radii
+uniform bool u_clipEnabled;
+uniform mat4 u_clip; // unit cube -> clip box frame, inside = [-1, 1]^3
 
 out vec3 v_color;
 out vec3 v_viewNormal;
 out float v_pointPx;
 
 void main() {
+    if (u_clipEnabled &&
+        any(greaterThan(abs((u_clip * vec4(a_position, 1.0)).xyz), vec3(1.0)))) {
+        gl_Position = vec4(0.0, 0.0, 2.0, 1.0); // beyond the far plane: not drawn
+        gl_PointSize = 1.0;
+        v_color = vec3(0.0);
+        v_viewNormal = vec3(0.0);
+        v_pointPx = 0.0;
+        return;
+    }
     vec4 viewPosition = u_view * vec4(a_position, 1.0);
     float radius = a_radius * u_sizeScale;
     viewPosition.z -= u_depthOffset * radius;

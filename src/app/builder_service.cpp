@@ -91,11 +91,12 @@ bool BuilderService::exportSortedStream(const QString& path) {
     });
 }
 
-bool BuilderService::exportPoints(const QString& path) {
-    return submitCloudExport(path, [](const std::string& file, const SortedCloud& cloud) {
-        exportCloudPoints(file, cloud);
-        return tr("Exported %1 points to %2")
-            .arg(cloud.sortedEnd())
+bool BuilderService::exportPoints(const QString& path, const std::optional<ClipBox>& clip) {
+    return submitCloudExport(path, [clip](const std::string& file, const SortedCloud& cloud) {
+        const std::uint64_t written = exportCloudPoints(file, cloud, clip);
+        return (clip ? tr("Exported %1 points inside the clip box to %2")
+                     : tr("Exported %1 points to %2"))
+            .arg(written)
             .arg(QString::fromStdString(file));
     });
 }

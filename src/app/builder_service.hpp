@@ -11,6 +11,7 @@
 #pragma once
 
 #include "pipeline/build_pipeline.hpp"
+#include "points/clip_box.hpp"
 
 #include <QElapsedTimer>
 #include <QObject>
@@ -48,7 +49,8 @@ public:
     bool rebuild(const BuildOptions& options);
     // Writes the kept sorted cloud as .oms, or as PLY/LAS (by extension) in Morton order.
     bool exportSortedStream(const QString& path);
-    bool exportPoints(const QString& path);
+    // With `clip` (source units): only the points inside the clip box.
+    bool exportPoints(const QString& path, const std::optional<ClipBox>& clip = std::nullopt);
     // Pipeline 3: loads a .omh hierarchy file; and writes the current hierarchy as .omh.
     void openHierarchy(const QString& path);
     bool saveHierarchy(const QString& path);

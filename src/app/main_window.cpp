@@ -1,8 +1,10 @@
 #include "main_window.hpp"
 
+#include "build/hierarchy.hpp"
 #include "build_panel.hpp"
 #include "builder_service.hpp"
 #include "charts_panel.hpp"
+#include "clip_panel.hpp"
 #include "cloud_view.hpp"
 #include "cut_panel.hpp"
 #include "measurements_panel.hpp"
@@ -150,6 +152,11 @@ void MainWindow::createDocks() {
     dock(m_buildPanel, tr("Build"), QStringLiteral("buildDock"), Qt::LeftDockWidgetArea);
     dock(m_cutPanel, tr("Cut progress"), QStringLiteral("cutDock"), Qt::RightDockWidgetArea);
     dock(m_chartsPanel, tr("Charts"), QStringLiteral("chartsDock"), Qt::BottomDockWidgetArea);
+    m_clipPanel = new ClipPanel(this);
+    QDockWidget* clipping =
+        dock(m_clipPanel, tr("Clipping"), QStringLiteral("clipDock"), Qt::LeftDockWidgetArea);
+    tabifyDockWidget(findChild<QDockWidget*>(QStringLiteral("buildDock")), clipping);
+    findChild<QDockWidget*>(QStringLiteral("buildDock"))->raise();
     m_measurementsPanel = new MeasurementsPanel(this);
     QDockWidget* measurements = dock(m_measurementsPanel, tr("Measurements"),
                                      QStringLiteral("measurementsDock"), Qt::BottomDockWidgetArea);
@@ -305,8 +312,16 @@ void MainWindow::connectActions() {
     connect(m_view, &CloudView::flyModeChanged, m_ui->actionFlyMode, &QAction::setChecked);
     createMeasureTools();
     m_view->setHoverPicking(true);
-    connect(m_view, &CloudView::pointHovered, this,
-            [this](const PickedPoint& point) { m_pickLabel->setText(pickedPointText(point)); });
+    connect(m_view, &CloudView::pointHovered, this, [this](const PickedPoint& point) {
+        m_pickLabel->setText(pickedPointText(point));
+        m_clipPanel->setPickedPoint(point.source);
+    });
+    connect(m_clipPanel, &ClipPanel::clipChanged, this,
+            [this](const std::optional<ClipBox>& clip) {
+                RenderSettings settings = m_view->renderSettings();
+                settings.clip = clip;
+                m_view->setRenderSettings(settings);
+            });
     connect(m_view, &CloudView::hoverLeftCloud, m_pickLabel, &QLabel::clear);
     connect(m_view, &CloudView::frameRendered, this, [this](const FrameStats& stats) {
         m_chartsPanel->setFrame(stats);
@@ -409,6 +424,10 @@ void MainWindow::connectService() {
     connect(m_service, &BuilderService::hierarchyChanged, this,
             [this](std::shared_ptr<const Hierarchy> hierarchy) {
                 m_cutPanel->setHierarchy(hierarchy);
+                if (hierarchy != nullptr) {
+                    const CubeTransform& cube = hierarchy->cloud().cube();
+                    m_clipPanel->setCloudBounds(cube.origin, cube.origin + glm::dvec3(cube.edge));
+                }
                 m_view->setHierarchy(std::move(hierarchy));
             });
     connect(m_service, &BuilderService::previewChanged, this,
@@ -475,7 +494,8 @@ void MainWindow::exportSortedStream(const QString& path) {
 }
 
 void MainWindow::exportPoints(const QString& path) {
-    m_service->exportPoints(path);
+    // With the view clipped, what is exported is what is shown: the points in the clip box.
+    m_service->exportPoints(path, m_view->renderSettings().clip);
 }
 
 void MainWindow::exportPotree(const QString& folder) {

@@ -30,6 +30,7 @@ class BuilderService;
 class BuildPanel;
 class ChartsPanel;
 class MeasurementsPanel;
+class ClipPanel;
 class CloudView;
 class CutPanel;
 
@@ -49,6 +50,7 @@ public:
     CutPanel* cutPanel() const { return m_cutPanel; }
     ChartsPanel* chartsPanel() const { return m_chartsPanel; }
     MeasurementsPanel* measurementsPanel() const { return m_measurementsPanel; }
+    ClipPanel* clipPanel() const { return m_clipPanel; }
     // The central CloudView.
     CloudView* cloudView() const { return m_view; }
     QStringList recentFiles() const { return m_recentFiles; }
@@ -102,6 +104,7 @@ private:
     CutPanel* m_cutPanel = nullptr;
     ChartsPanel* m_chartsPanel = nullptr;
     MeasurementsPanel* m_measurementsPanel = nullptr;
+    ClipPanel* m_clipPanel = nullptr;
     QStringList m_recentFiles;
     QString m_title; // what is shown: file name or "generated scene"
     PipelineProgress m_progress;

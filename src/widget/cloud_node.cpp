@@ -174,6 +174,9 @@ void CloudNode::evaluateFront(RenderContext& context) {
     camera.eye = context.camera->eye();
     camera.pixelsPerUnitAtUnitDistance =
         context.camera->pixelsPerUnitAtUnitDistance(context.heightPx);
+    if (settings.clip) {
+        camera.clip = toUnitCube(*settings.clip, m_hierarchy->cloud().cube());
+    }
     FrontOptions options;
     options.projectionThresholdPx = settings.projectionThresholdPx;
     options.pointBudget = settings.pointBudget;
@@ -334,6 +337,14 @@ void CloudNode::setCommonUniforms(QOpenGLShaderProgram& program, const RenderCon
     program.setUniformValue("u_maxPointPx", kMaxPointPx);
     program.setUniformValue("u_depthOffset", depthOffset);
     program.setUniformValue("u_colorMode", effectiveColorMode(settings));
+    // The clip box in the unit cube of the cloud drawn (the preview before a hierarchy: the
+    // box is in source units, so it waits for the hierarchy's cube).
+    const bool clipped = settings.clip.has_value() && m_hierarchy != nullptr;
+    program.setUniformValue("u_clipEnabled", clipped);
+    if (clipped) {
+        const glm::mat4 clip = toUnitCube(*settings.clip, m_hierarchy->cloud().cube()).toBoxMatrix();
+        program.setUniformValue("u_clip", QMatrix4x4(glm::value_ptr(clip)).transposed());
+    }
     const float low = hasBounds() ? static_cast<float>(m_boundsMin.z) : 0.0f;
     const float high = hasBounds() ? static_cast<float>(m_boundsMax.z) : 1.0f;
     program.setUniformValue("u_heightRange", QVector2D(low, high));

@@ -1,6 +1,7 @@
 // Value types of the CloudView API: what to draw and how, and what a frame cost.
 #pragma once
 
+#include "points/clip_box.hpp"
 #include "points/morton.hpp"
 
 #include <QMetaType>
@@ -8,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <glm/vec3.hpp>
+#include <optional>
 
 namespace omicron {
 
@@ -47,6 +49,9 @@ struct RenderSettings {
     EdlMode edl = EdlMode::Auto;
     float edlStrength = 1.0f; // how dark an edge one log2 step of depth deep gets
     float edlRadiusPx = 1.4f; // how far the neighbours it compares with are
+    // Only the points inside this box (source coordinates: the file's units) are drawn, and
+    // octree cells wholly outside it are culled by the front. None: everything.
+    std::optional<ClipBox> clip;
     friend bool operator==(const RenderSettings&, const RenderSettings&) = default;
 };
 

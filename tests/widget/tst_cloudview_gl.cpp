@@ -313,6 +313,45 @@ private slots:
         QVERIFY(with != without);
     }
 
+    // The clip box: in every render mode, the grid points outside it are not drawn (no depth
+    // there to pick) and those inside are; the front culls cells wholly outside.
+    void theClipBoxDrawsOnlyThePointsInside() {
+        QTemporaryDir dir;
+        const QString path = dir.filePath(QStringLiteral("grid.ply"));
+        writeGrid(path, 0.0);
+        const auto hierarchy = test::buildHierarchy(path, BuildOptions{});
+        CloudView view;
+        view.setHierarchy(hierarchy);
+        view.setStandardView(StandardView::Top);
+        view.resize(400, 400);
+        view.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&view));
+        for (const RenderMode mode :
+             {RenderMode::ComputePoints, RenderMode::Points, RenderMode::Splats}) {
+            RenderSettings settings = plainSettings();
+            settings.mode = mode;
+            // Columns 0..9 (x up to 500009.5), turned by a quarter turn: its x along +y.
+            settings.clip = ClipBox{{500004.75, 4000009.5, 100.0}, {10.0, 4.75, 1.0},
+                                    std::acos(-1.0) / 2.0};
+            view.setRenderSettings(settings);
+            view.update();
+            QTRY_VERIFY(view.lastFrameStats().pointsDrawn > 0);
+            QTest::qWait(50);
+            const QString trace = QStringLiteral("mode %1").arg(static_cast<int>(mode));
+            for (int j : {2, 10, 17}) {
+                const auto inside = view.pickCloudPoint(
+                    pixelOf(view, *hierarchy, glm::dvec3(500003.0, 4000000.0 + j, 100.0)));
+                QVERIFY2(inside && std::abs(inside->source.x - 500003.0) < 1e-3,
+                         qPrintable(trace));
+                const auto outside = view.pickCloudPoint(
+                    pixelOf(view, *hierarchy, glm::dvec3(500016.0, 4000000.0 + j, 100.0)));
+                QVERIFY2(!outside || outside->source.x < 500010.0,
+                         qPrintable(trace + QStringLiteral(": picked %1").arg(outside->source.x)));
+            }
+            QVERIFY2(view.lastFrameStats().pointsDrawn < 400, qPrintable(trace));
+        }
+    }
+
     void lionRendersInColourAndAsSplats() {
         const QString path = test::sharedDataFile("lion.ply");
         if (path.isEmpty()) {

@@ -260,6 +260,7 @@ FrontEvaluation Front::evaluate(const FrontCamera& camera, const FrontOptions& o
     ++state.evaluations;
     state.camera = camera;
     state.frustum = frustumPlanes(camera.viewProjection);
+    state.frustum.clip = camera.clip;
     state.thresholdPx = options.projectionThresholdPx;
     state.loadPublished();
     state.takeInsertions(result);

@@ -21,6 +21,7 @@
 #pragma once
 
 #include "build/hierarchy.hpp"
+#include "points/clip_box.hpp"
 #include "points/morton.hpp"
 
 #include <chrono>
@@ -29,6 +30,7 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -43,6 +45,8 @@ struct FrontCamera {
     // For an orthographic camera: pixels per unit length (distance is then ignored).
     double pixelsPerUnitAtUnitDistance = 1000.0;
     bool orthographic = false;
+    // Only what lies in this box (unit cube) is drawn: cells wholly outside are culled.
+    std::optional<ClipBox> clip;
 };
 
 struct FrontOptions {

@@ -22,7 +22,7 @@ FrustumPlanes frustumPlanes(const glm::dmat4& m) {
     // Gribb & Hartmann: row i of the matrix (GLM is column-major, m[column][row]).
     const auto row = [&](int i) { return glm::dvec4(m[0][i], m[1][i], m[2][i], m[3][i]); };
     const glm::dvec4 r0 = row(0), r1 = row(1), r2 = row(2), r3 = row(3);
-    return {{r3 + r0, r3 - r0, r3 + r1, r3 - r1, r3 + r2, r3 - r2}};
+    return {{r3 + r0, r3 - r0, r3 + r1, r3 - r1, r3 + r2, r3 - r2}, std::nullopt};
 }
 
 bool intersectsFrustum(const FrustumPlanes& frustum, const CellBox& box) {
@@ -35,7 +35,7 @@ bool intersectsFrustum(const FrustumPlanes& frustum, const CellBox& box) {
             return false;
         }
     }
-    return true;
+    return !frustum.clip || frustum.clip->intersects(box.min, box.edge);
 }
 
 double projectedSizePx(const CellBox& box, const FrontCamera& camera) {

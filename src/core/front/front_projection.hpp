@@ -4,11 +4,13 @@
 #pragma once
 
 #include "front/front.hpp"
+#include "points/clip_box.hpp"
 #include "points/morton.hpp"
 
 #include <array>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
+#include <optional>
 
 namespace omicron {
 
@@ -26,11 +28,14 @@ CellBox cellBox(morton::Code code);
 // (normal, offset): a point p is inside when dot(normal, p) + offset >= 0 for all six.
 struct FrustumPlanes {
     std::array<glm::dvec4, 6> planes;
+    // The camera's clip box (unit cube), if any: a cell wholly outside it is not visible
+    // either, so clipped-away nodes cost neither drawing nor points of the budget.
+    std::optional<ClipBox> clip;
 };
 FrustumPlanes frustumPlanes(const glm::dmat4& viewProjection);
 
 // Conservative: true unless the whole box lies outside one plane (a box near a frustum corner
-// may be kept; it costs a little drawing, never a hole).
+// may be kept; it costs a little drawing, never a hole) or outside the clip box.
 bool intersectsFrustum(const FrustumPlanes& frustum, const CellBox& box);
 
 // The cell's diagonal in pixels: diagonal / distance(eye, centre) * pixelsPerUnitAtUnitDistance

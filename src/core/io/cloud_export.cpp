@@ -26,7 +26,34 @@ std::string lowerExtension(const std::string& path) {
 
 } // namespace
 
-void exportCloudPoints(const std::string& path, const SortedCloud& cloud) {
+namespace {
+
+// The points of `all` inside `box` (unit cube), attributes kept alongside.
+PointBatch insideBox(const PointBatch& all, const ClipBox& box) {
+    PointBatch kept;
+    kept.attributes = all.attributes;
+    for (std::size_t i = 0; i < all.size(); ++i) {
+        if (!box.contains(glm::dvec3(all.positions[i]))) {
+            continue;
+        }
+        kept.positions.push_back(all.positions[i]);
+        if (all.attributes.has(Attribute::Normal)) {
+            kept.normals.push_back(all.normals[i]);
+        }
+        if (all.attributes.has(Attribute::Color)) {
+            kept.colors.push_back(all.colors[i]);
+        }
+        if (all.attributes.has(Attribute::Intensity)) {
+            kept.intensities.push_back(all.intensities[i]);
+        }
+    }
+    return kept;
+}
+
+} // namespace
+
+std::uint64_t exportCloudPoints(const std::string& path, const SortedCloud& cloud,
+                                const std::optional<ClipBox>& clip) {
     const std::string extension = lowerExtension(path);
     if (extension != ".ply" && extension != ".las") {
         throw OutputError(path + ": cannot export points: expected a .ply or .las file name");
@@ -36,12 +63,18 @@ void exportCloudPoints(const std::string& path, const SortedCloud& cloud) {
     }
     PointBatch points;
     cloud.copyRange(0, cloud.sortedEnd(), points);
+    if (clip) {
+        points = insideBox(points, toUnitCube(*clip, cloud.cube()));
+        if (points.empty()) {
+            throw OutputError(path + ": cannot export points: none lies inside the clip box");
+        }
+    }
     if (extension == ".ply") {
         PlyWriteOptions options;
         options.offset = plyStorageOffset(cloud.cube(), cloud.sourceOffset());
         options.comments.push_back("exported by omicron (points in Morton order)");
         writePly(path, points, cloud.cube(), options);
-        return;
+        return points.size();
     }
     LasWriteOptions options;
     options.pointFormat = cloud.attributes().has(Attribute::Color) ? 2 : 0;
@@ -52,6 +85,7 @@ void exportCloudPoints(const std::string& path, const SortedCloud& cloud) {
     const double step = std::pow(10.0, std::ceil(std::log10(cloud.cube().edge / 1e9)));
     options.scale = glm::dvec3(step);
     writeLas(path, points, cloud.cube(), options);
+    return points.size();
 }
 
 } // namespace omicron
