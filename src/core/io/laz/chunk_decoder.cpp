@@ -90,10 +90,10 @@ ChunkDecoder::ChunkDecoder(const LaszipVlr& vlr) : m_vlr(vlr) {
 
 ChunkDecoder::~ChunkDecoder() = default;
 
-void ChunkDecoder::fail(std::uint64_t byteInChunk, const std::string& detail) const {
+void ChunkDecoder::fail(std::uint64_t byteInChunk, const std::string& detail,
+                        InputErrorKind kind) const {
     const Chunk& chunk = m_context.chunk;
-    throw InputError(InputErrorKind::CorruptData, *m_context.path,
-                     InputLocation::byte(chunk.offset + byteInChunk),
+    throw InputError(kind, *m_context.path, InputLocation::byte(chunk.offset + byteInChunk),
                      "LAZ chunk " + std::to_string(m_context.index) + " of " +
                          std::to_string(m_context.count) + " (points " +
                          range(chunk.firstPoint, chunk.pointCount) + ", bytes " +
@@ -149,9 +149,11 @@ void ChunkDecoder::startLayered() {
     std::uint32_t count;
     std::memcpy(&count, m_bytes.data() + at, sizeof count);
     if (count != m_context.chunk.pointCount) {
-        fail(at, "the chunk says it holds " + std::to_string(count) +
-                     " points, but the chunk table says " +
-                     std::to_string(m_context.chunk.pointCount));
+        fail(at,
+             "the chunk says it holds " + std::to_string(count) + " points, but the chunk " +
+                 "table and the header's point count give it " +
+                 std::to_string(m_context.chunk.pointCount),
+             InputErrorKind::CountMismatch);
     }
     at += 4;
     m_layerSizes.assign(layerCount, 0);
@@ -245,8 +247,9 @@ void ChunkDecoder::checkAfterDecode() {
         const std::uint64_t end = m_bytes.size();
         // A one-point chunk needs no stream: whatever follows its record is not read.
         if (m_stream.overran() && m_context.chunk.pointCount > 1) {
-            fail(end, "its data ends before its points are decoded: the chunk is truncated or "
-                      "corrupt");
+            fail(end, "its data ends before its " + std::to_string(m_context.chunk.pointCount) +
+                          " points are decoded: the chunk is truncated or corrupt, or the "
+                          "header declares more points than the file holds");
         }
         // The encoder flushes exactly the bytes its decoder reads, so a chunk that decodes
         // from fewer bytes than the table gives it is corrupt (or the table is).

@@ -7,6 +7,7 @@
 // count (uint32), the byte count of every layer of every item (uint32 each), then the layers.
 #pragma once
 
+#include "io/input_error.hpp"
 #include "io/laz/chunk_table.hpp"
 #include "io/laz/laszip_vlr.hpp"
 #include "io/laz/layered_item_decoder.hpp"
@@ -41,8 +42,9 @@ public:
     std::size_t recordLength() const { return m_recordLength; }
 
     // Starts on a chunk whose bytes (context.chunk.bytes of them, at least one record) are
-    // `bytes`; they must outlive the decoding. Throws InputError (CorruptData) when a layered
-    // chunk's point count or layer sizes do not fit the chunk.
+    // `bytes`; they must outlive the decoding. Throws InputError when a layered chunk's layer
+    // sizes do not fit the chunk (CorruptData) or its point count is not the one the chunk
+    // table and the header give it (CountMismatch).
     void start(std::span<const std::uint8_t> bytes, const ChunkContext& context);
 
     // Decodes the chunk's next `count` points into `records` (count * recordLength() bytes);
@@ -59,7 +61,8 @@ private:
     void decodePointwise(std::uint8_t* records, std::uint64_t count);
     void decodeLayered(std::uint8_t* records, std::uint64_t count);
     void checkAfterDecode();
-    [[noreturn]] void fail(std::uint64_t byteInChunk, const std::string& detail) const;
+    [[noreturn]] void fail(std::uint64_t byteInChunk, const std::string& detail,
+                           InputErrorKind kind = InputErrorKind::CorruptData) const;
 
     const LaszipVlr& m_vlr;
     std::size_t m_recordLength = 0;

@@ -147,7 +147,7 @@ private:
             byteCounts[i] = lastBytes;
         }
         if (decoder.overran()) {
-            fail(InputErrorKind::CorruptData, codedAt,
+            fail(InputErrorKind::CorruptData, table,
                  "the LAZ chunk table is truncated or corrupt: its " + std::to_string(count) +
                      " entries need more than the " + std::to_string(coded.size()) +
                      " bytes after it");

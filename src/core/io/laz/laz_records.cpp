@@ -101,9 +101,8 @@ public:
     }
 
     std::string describe() const override {
-        std::string text = "LAZ " + m_vlr.describe() + ", " +
-                           std::to_string(m_layout.chunks.size()) + " chunk" +
-                           (m_layout.chunks.size() == 1 ? "" : "s");
+        std::string text = m_vlr.describe() + ", " + std::to_string(m_layout.chunks.size()) +
+                           " chunk" + (m_layout.chunks.size() == 1 ? "" : "s");
         if (m_vlr.compressor == laz::Compressor::Pointwise) {
             return text;
         }

@@ -76,6 +76,10 @@ struct ReferencePair {
     std::uint64_t points;
 };
 
+void PrintTo(const ReferencePair& pair, std::ostream* out) {
+    *out << pair.laz << " vs " << pair.las;
+}
+
 class LazDecoder : public ::testing::TestWithParam<ReferencePair> {};
 
 TEST_P(LazDecoder, MatchesReferenceByteForByte) {
