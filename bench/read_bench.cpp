@@ -2,15 +2,24 @@
 // with the page cache warm, so the ratio shows parsing cost rather than disk speed.
 //
 // usage: read_bench FILE [--keep-temp]
+//        read_bench --laz FILE.laz [SAME_POINTS.las]
 // FILE is read as it is; then the same points are written as binary big-endian PLY, ascii PLY,
 // LAS 1.4 (point format 7) and XYZ text in a temporary folder and each is measured too.
+// --laz measures the LAZ reader with 1 and 2 oneTBB threads: phase=decode (chunks to LAS
+// records only) and phase=read (points delivered, as any reader), against reading the same
+// points uncompressed (phase=read of the LAS file, one thread):
+//   bench=read reader=laz phase=decode threads=2 points=... mpoints_per_s=...
+//   speedup_vs_1_thread=... las_mpoints_per_s=... ratio_vs_las=...
 // One line per reader and phase:
 //   bench=read reader=ply_binary_little_endian phase=parse points=... mpoints_per_s=...
 //   mb_per_s=... raw_mb_per_s=... ratio_vs_raw=...
 // phase=open_and_read includes the bounds pre-pass of formats whose header has no bounds;
 // phase=parse passes the bounds in (OpenOptions::knownBounds), so it is the streaming parse.
 #include "bench_timing.hpp"
+#include "io/file_stream.hpp"
+#include "io/las/las_header.hpp"
 #include "io/las/las_writer.hpp"
+#include "io/laz/laz_records.hpp"
 #include "io/ply/ply_writer.hpp"
 #include "io/point_reader.hpp"
 #include "io/xyz/xyz_writer.hpp"
@@ -21,6 +30,7 @@
 #include <fcntl.h>
 #include <filesystem>
 #include <string>
+#include <tbb/global_control.h>
 #include <unistd.h>
 #include <vector>
 
@@ -88,18 +98,92 @@ std::string label(omicron::CloudFormat format) {
         return "ply_binary_big_endian";
     case omicron::CloudFormat::Las:
         return "las";
+    case omicron::CloudFormat::Laz:
+        return "laz";
     case omicron::CloudFormat::Xyz:
         return "xyz";
     }
     return "unknown";
 }
 
+// LAZ chunks to LAS records, nothing else: the decoder's own speed.
+std::uint64_t decodeLazRecords(const std::string& path) {
+    auto stream = std::make_unique<omicron::FileStream>(path);
+    const omicron::las::Header header = omicron::las::readHeader(*stream);
+    auto records = omicron::openLazRecords(std::move(stream), header);
+    std::uint64_t points = 0;
+    records->forEachBlock([&](const omicron::LasRecordBlock& block) {
+        points += block.count;
+        return true;
+    });
+    return points;
+}
+
+void printLaz(const char* phase, int threads, std::uint64_t points, double seconds,
+              double oneThreadSeconds, double lasPointsPerS) {
+    const double pointsPerS = points / seconds;
+    std::printf("bench=read reader=laz phase=%s threads=%d points=%llu ms=%.1f "
+                "mpoints_per_s=%.2f speedup_vs_1_thread=%.2f",
+                phase, threads, static_cast<unsigned long long>(points), seconds * 1e3,
+                pointsPerS / 1e6, oneThreadSeconds / seconds);
+    if (lasPointsPerS > 0) {
+        std::printf(" las_mpoints_per_s=%.2f ratio_vs_las=%.3f", lasPointsPerS / 1e6,
+                    pointsPerS / lasPointsPerS);
+    }
+    std::printf("\n");
+    std::fflush(stdout);
+}
+
+int measureLaz(const std::string& laz, const std::string& las) {
+    rawRead(laz); // warm the page cache
+    double lasPointsPerS = 0;
+    if (!las.empty()) {
+        rawRead(las);
+        tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+        std::uint64_t points = 0;
+        const double seconds = bestSeconds(3, [&] { points = readAll(las, {}); });
+        lasPointsPerS = points / seconds;
+        std::printf("bench=read reader=las phase=read threads=1 points=%llu ms=%.1f "
+                    "mpoints_per_s=%.2f\n",
+                    static_cast<unsigned long long>(points), seconds * 1e3, lasPointsPerS / 1e6);
+    }
+    double oneThreadDecode = 0;
+    double oneThreadRead = 0;
+    for (const int threads : {1, 2}) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
+                                  static_cast<std::size_t>(threads));
+        std::uint64_t points = 0;
+        const double decode = bestSeconds(3, [&] { points = decodeLazRecords(laz); });
+        const double read = bestSeconds(3, [&] { points = readAll(laz, {}); });
+        if (threads == 1) {
+            oneThreadDecode = decode;
+            oneThreadRead = read;
+        }
+        printLaz("decode", threads, points, decode, oneThreadDecode, lasPointsPerS);
+        printLaz("read", threads, points, read, oneThreadRead, lasPointsPerS);
+    }
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
     if (argc < 2) {
-        std::fprintf(stderr, "usage: read_bench FILE [--keep-temp]\n");
+        std::fprintf(stderr, "usage: read_bench FILE [--keep-temp]\n"
+                             "       read_bench --laz FILE.laz [SAME_POINTS.las]\n");
         return 2;
+    }
+    if (std::strcmp(argv[1], "--laz") == 0) {
+        if (argc < 3) {
+            std::fprintf(stderr, "usage: read_bench --laz FILE.laz [SAME_POINTS.las]\n");
+            return 2;
+        }
+        try {
+            return measureLaz(argv[2], argc > 3 ? argv[3] : "");
+        } catch (const std::exception& error) {
+            std::fprintf(stderr, "read_bench: %s\n", error.what());
+            return 1;
+        }
     }
     const std::string input = argv[1];
     const bool keepTemp = argc > 2 && std::strcmp(argv[2], "--keep-temp") == 0;
