@@ -17,6 +17,11 @@ constexpr std::size_t kItemCountAt = 32;
 constexpr std::size_t kItemsAt = 34;
 constexpr std::size_t kItemBytes = 6;
 
+// Each extra byte has its own models (about 2.3 KB per byte, per scanner channel in layered
+// chunks, per chunk decoded at once), so a record of 64 KB of extra bytes would cost hundreds
+// of megabytes whatever the file's size. Real files carry a few dozen.
+constexpr std::uint16_t kMaxExtraBytes = 1024;
+
 template <typename T> T load(std::span<const std::uint8_t> bytes, std::size_t at) {
     T value;
     std::memcpy(&value, bytes.data() + at, sizeof value);
@@ -208,6 +213,13 @@ private:
                  std::string("LAZ item ") + toString(item.type) + " has size " +
                      std::to_string(item.size) + ", expected " +
                      (fixed != 0 ? std::to_string(fixed) : std::string("at least 1")));
+        }
+        const bool extraBytes = item.type == ItemType::Byte || item.type == ItemType::Byte14;
+        if (extraBytes && item.size > kMaxExtraBytes) {
+            fail(InputErrorKind::UnsupportedFeature, at + 2,
+                 "LAZ extra bytes item of " + std::to_string(item.size) +
+                     " bytes a point: at most " + std::to_string(kMaxExtraBytes) +
+                     " are supported");
         }
         if (item.type == ItemType::WavePacket13 || item.type == ItemType::WavePacket14) {
             fail(InputErrorKind::UnsupportedFeature, at,

@@ -58,9 +58,9 @@ struct LaszipVlr {
 // Parses the record's payload (at byte `payloadOffset` of `path`, for errors) and checks it
 // against the header's point format (0-10, compression bits cleared) and record length: a
 // known compressor and coder, a chunk size > 0, items whose types, versions and sizes are
-// those of the point format followed by the extra bytes. Throws InputError naming the field's
-// byte: MalformedHeader, or UnsupportedFeature (compressor, coder, item type or version,
-// waveform items).
+// those of the point format followed by the extra bytes (at most 1024). Throws InputError
+// naming the field's byte: MalformedHeader, or UnsupportedFeature (compressor, coder, item
+// type or version, waveform items, more extra bytes).
 LaszipVlr parseLaszipVlr(std::span<const std::uint8_t> payload, const std::string& path,
                          std::uint64_t payloadOffset, std::uint8_t pointFormat,
                          std::uint16_t recordLength);

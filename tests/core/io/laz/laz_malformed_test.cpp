@@ -283,6 +283,15 @@ const Corruption kCorruptions[] = {
          return at(f.vlr + 32);
      },
      InputErrorKind::MalformedHeader, "fill 42-byte records"},
+    // Every extra byte has its own models: a huge extra-bytes item would allocate hundreds of
+    // megabytes for a file of a few.
+    {"TooManyExtraBytes", "terrascan_fmt8.laz",
+     [](LazFile& f) {
+         put<std::uint16_t>(f.bytes, las::field::recordLength, 38 + 20000);
+         put<std::uint16_t>(f.bytes, f.item(2) + 2, 20000);
+         return at(f.item(2) + 2);
+     },
+     InputErrorKind::UnsupportedFeature, "extra bytes item of 20000 bytes"},
 };
 
 class LazMalformed : public ::testing::TestWithParam<Corruption> {};
