@@ -2,14 +2,15 @@
 // with the page cache warm, so the ratio shows parsing cost rather than disk speed.
 //
 // usage: read_bench FILE [--keep-temp]
-//        read_bench --laz FILE.laz [SAME_POINTS.las]
+//        read_bench --laz FILE.laz [SAME_POINTS.las] [--laz-perf NODE_MODULES_DIR]
 // FILE is read as it is; then the same points are written as binary big-endian PLY, ascii PLY,
 // LAS 1.4 (point format 7) and XYZ text in a temporary folder and each is measured too.
 // --laz measures the LAZ reader with 1 and 2 oneTBB threads: phase=decode (chunks to LAS
 // records only) and phase=read (points delivered, as any reader), against reading the same
-// points uncompressed (phase=read of the LAS file, one thread):
+// points uncompressed (phase=read of the LAS file, one thread) and, with --laz-perf, against the
+// npm laz-perf decoder (WebAssembly, run by node on the same file; bench/laz_perf_decode.js):
 //   bench=read reader=laz phase=decode threads=2 points=... mpoints_per_s=...
-//   speedup_vs_1_thread=... las_mpoints_per_s=... ratio_vs_las=...
+//   speedup_vs_1_thread=... las_mpoints_per_s=... ratio_vs_las=... ratio_vs_laz_perf=...
 // One line per reader and phase:
 //   bench=read reader=ply_binary_little_endian phase=parse points=... mpoints_per_s=...
 //   mb_per_s=... raw_mb_per_s=... ratio_vs_raw=...
@@ -119,8 +120,37 @@ std::uint64_t decodeLazRecords(const std::string& path) {
     return points;
 }
 
+// Runs bench/laz_perf_decode.js on `laz`; prints its line and returns its points/s (0 when it
+// cannot run: no node, no laz-perf in `nodeModules`).
+double lazPerfPointsPerS(const std::string& nodeModules, const std::string& laz) {
+    const auto quoted = [](const std::string& text) {
+        std::string out = "'";
+        for (const char c : text) {
+            out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+        }
+        return out + "'";
+    };
+    const std::string command = "node " + quoted(OMICRON_BENCH_DIR "/laz_perf_decode.js") + " " +
+                                quoted(nodeModules) + " " + quoted(laz);
+    FILE* pipe = ::popen(command.c_str(), "r");
+    if (pipe == nullptr) {
+        return 0;
+    }
+    char line[512] = {};
+    const bool got = std::fgets(line, sizeof line, pipe) != nullptr;
+    const int status = ::pclose(pipe);
+    const char* rate = got ? std::strstr(line, "mpoints_per_s=") : nullptr;
+    if (status != 0 || rate == nullptr) {
+        std::fprintf(stderr, "read_bench: laz-perf did not run (%s)\n", command.c_str());
+        return 0;
+    }
+    std::printf("%s", line);
+    std::fflush(stdout);
+    return std::atof(rate + std::strlen("mpoints_per_s=")) * 1e6;
+}
+
 void printLaz(const char* phase, int threads, std::uint64_t points, double seconds,
-              double oneThreadSeconds, double lasPointsPerS) {
+              double oneThreadSeconds, double lasPointsPerS, double lazPerfPointsPerS) {
     const double pointsPerS = points / seconds;
     std::printf("bench=read reader=laz phase=%s threads=%d points=%llu ms=%.1f "
                 "mpoints_per_s=%.2f speedup_vs_1_thread=%.2f",
@@ -130,12 +160,17 @@ void printLaz(const char* phase, int threads, std::uint64_t points, double secon
         std::printf(" las_mpoints_per_s=%.2f ratio_vs_las=%.3f", lasPointsPerS / 1e6,
                     pointsPerS / lasPointsPerS);
     }
+    if (lazPerfPointsPerS > 0) {
+        std::printf(" laz_perf_mpoints_per_s=%.2f ratio_vs_laz_perf=%.2f", lazPerfPointsPerS / 1e6,
+                    pointsPerS / lazPerfPointsPerS);
+    }
     std::printf("\n");
     std::fflush(stdout);
 }
 
-int measureLaz(const std::string& laz, const std::string& las) {
+int measureLaz(const std::string& laz, const std::string& las, const std::string& lazPerf) {
     rawRead(laz); // warm the page cache
+    const double lazPerfRate = lazPerf.empty() ? 0 : lazPerfPointsPerS(lazPerf, laz);
     double lasPointsPerS = 0;
     if (!las.empty()) {
         rawRead(las);
@@ -159,8 +194,8 @@ int measureLaz(const std::string& laz, const std::string& las) {
             oneThreadDecode = decode;
             oneThreadRead = read;
         }
-        printLaz("decode", threads, points, decode, oneThreadDecode, lasPointsPerS);
-        printLaz("read", threads, points, read, oneThreadRead, lasPointsPerS);
+        printLaz("decode", threads, points, decode, oneThreadDecode, lasPointsPerS, lazPerfRate);
+        printLaz("read", threads, points, read, oneThreadRead, lasPointsPerS, lazPerfRate);
     }
     return 0;
 }
@@ -170,16 +205,30 @@ int measureLaz(const std::string& laz, const std::string& las) {
 int main(int argc, char** argv) {
     if (argc < 2) {
         std::fprintf(stderr, "usage: read_bench FILE [--keep-temp]\n"
-                             "       read_bench --laz FILE.laz [SAME_POINTS.las]\n");
+                             "       read_bench --laz FILE.laz [SAME_POINTS.las] "
+                             "[--laz-perf NODE_MODULES_DIR]\n");
         return 2;
     }
     if (std::strcmp(argv[1], "--laz") == 0) {
-        if (argc < 3) {
-            std::fprintf(stderr, "usage: read_bench --laz FILE.laz [SAME_POINTS.las]\n");
+        std::string laz;
+        std::string las;
+        std::string lazPerf;
+        for (int i = 2; i < argc; ++i) {
+            if (std::strcmp(argv[i], "--laz-perf") == 0 && i + 1 < argc) {
+                lazPerf = argv[++i];
+            } else if (laz.empty()) {
+                laz = argv[i];
+            } else {
+                las = argv[i];
+            }
+        }
+        if (laz.empty()) {
+            std::fprintf(stderr, "usage: read_bench --laz FILE.laz [SAME_POINTS.las] "
+                                 "[--laz-perf NODE_MODULES_DIR]\n");
             return 2;
         }
         try {
-            return measureLaz(argv[2], argc > 3 ? argv[3] : "");
+            return measureLaz(laz, las, lazPerf);
         } catch (const std::exception& error) {
             std::fprintf(stderr, "read_bench: %s\n", error.what());
             return 1;
