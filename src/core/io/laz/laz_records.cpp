@@ -14,17 +14,11 @@ namespace omicron {
 
 namespace {
 
-// Compressed plus decoded bytes of the chunks decoded together (a batch). Chunks of the
-// default 50,000 points make 1 to 4 MB each, so a batch holds enough of them to keep every
-// thread busy.
-constexpr std::uint64_t kBatchBytes = std::uint64_t{64} << 20;
-// A chunk whose decoded records alone exceed this is decoded alone, in slices of this size.
-constexpr std::uint64_t kSliceBytes = std::uint64_t{8} << 20;
-
 class LazRecords final : public LasRecordSource {
 public:
-    LazRecords(std::unique_ptr<FileStream> stream, const las::Header& header)
-        : m_stream(std::move(stream)), m_header(header) {
+    LazRecords(std::unique_ptr<FileStream> stream, const las::Header& header,
+               const LazStreaming& streaming)
+        : m_stream(std::move(stream)), m_header(header), m_streaming(streaming) {
         std::vector<std::uint8_t> payload(header.laszipRecordLength);
         m_stream->seek(header.laszipRecordOffset);
         m_stream->readExact(payload.data(), payload.size(), "the 'laszip encoded' record");
@@ -38,7 +32,7 @@ public:
     void forEachBlock(const BlockVisitor& visit) override {
         std::size_t next = 0;
         while (next < m_layout.chunks.size()) {
-            if (decodedBytes(next) > kBatchBytes) {
+            if (decodedBytes(next) > m_streaming.batchBytes) {
                 if (!streamLargeChunk(next, visit)) {
                     return;
                 }
@@ -47,8 +41,8 @@ public:
             }
             std::size_t end = next + 1;
             std::uint64_t batchBytes = chunkBytes(next);
-            while (end < m_layout.chunks.size() && decodedBytes(end) <= kBatchBytes &&
-                   batchBytes + chunkBytes(end) <= kBatchBytes) {
+            while (end < m_layout.chunks.size() && decodedBytes(end) <= m_streaming.batchBytes &&
+                   batchBytes + chunkBytes(end) <= m_streaming.batchBytes) {
                 batchBytes += chunkBytes(end);
                 ++end;
             }
@@ -74,7 +68,7 @@ public:
         }
         std::uint64_t visited = std::min(spread, maxRecords);
         const std::uint64_t prefix = std::min(chunks[0].pointCount, maxRecords - visited + 1);
-        if (prefix > 1 && decodedBytes(0) <= kBatchBytes) {
+        if (prefix > 1 && decodedBytes(0) <= m_streaming.batchBytes) {
             const std::vector<std::uint8_t> bytes = readChunks(0, 1);
             laz::ChunkDecoder decoder(m_vlr);
             decoder.start(bytes, context(0));
@@ -198,7 +192,7 @@ private:
         laz::ChunkDecoder decoder(m_vlr);
         decoder.start(compressed, context(c));
         const std::uint64_t sliceRecords =
-            std::max<std::uint64_t>(1, kSliceBytes / m_header.recordLength);
+            std::max<std::uint64_t>(1, m_streaming.sliceBytes / m_header.recordLength);
         std::vector<std::uint8_t> records(static_cast<std::size_t>(
             std::min(sliceRecords, chunk.pointCount) * m_header.recordLength));
         for (std::uint64_t done = 0; done < chunk.pointCount;) {
@@ -217,6 +211,7 @@ private:
 
     std::unique_ptr<FileStream> m_stream;
     las::Header m_header;
+    LazStreaming m_streaming;
     laz::LaszipVlr m_vlr;
     laz::ChunkLayout m_layout;
 };
@@ -224,8 +219,9 @@ private:
 } // namespace
 
 std::unique_ptr<LasRecordSource> openLazRecords(std::unique_ptr<FileStream> stream,
-                                                const las::Header& header) {
-    return std::make_unique<LazRecords>(std::move(stream), header);
+                                                const las::Header& header,
+                                                const LazStreaming& streaming) {
+    return std::make_unique<LazRecords>(std::move(stream), header, streaming);
 }
 
 } // namespace omicron

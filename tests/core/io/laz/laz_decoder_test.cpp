@@ -21,12 +21,12 @@ struct Records {
     std::uint64_t blocks = 0;
 };
 
-Records decodeLaz(const std::string& path) {
+Records decodeLaz(const std::string& path, const LazStreaming& streaming = {}) {
     auto stream = std::make_unique<FileStream>(path);
     Records result;
     result.header = las::readHeader(*stream);
     EXPECT_TRUE(result.header.compressed);
-    auto records = openLazRecords(std::move(stream), result.header);
+    auto records = openLazRecords(std::move(stream), result.header, streaming);
     std::uint64_t nextIndex = 0;
     records->forEachBlock([&](const LasRecordBlock& block) {
         EXPECT_EQ(block.firstIndex, nextIndex);
@@ -108,6 +108,28 @@ TEST_P(LazDecoder, SameRecordsWithOneAndTwoThreads) {
     }
     EXPECT_EQ(one.bytes.size(), GetParam().points * one.header.recordLength);
     EXPECT_TRUE(sameRecords(one, two));
+}
+
+// The streaming limits change how chunks are grouped and split, never the records: batches of
+// a few chunks, and chunks too large for a batch decoded in slices of a few records.
+TEST_P(LazDecoder, SmallBatchesAndSlicesDecodeTheSameRecords) {
+    OMICRON_REQUIRE_SHARED_FILE(lazPath, GetParam().laz);
+    OMICRON_REQUIRE_SHARED_FILE(lasPath, GetParam().las);
+    const Records reference = readLas(lasPath);
+    const std::uint64_t recordLength = reference.header.recordLength;
+
+    LazStreaming slices;
+    slices.batchBytes = 4096; // most chunks are larger: decoded alone
+    slices.sliceBytes = 20 * recordLength;
+    const Records sliced = decodeLaz(lazPath, slices);
+    EXPECT_TRUE(sameRecords(sliced, reference));
+    // At least one block per 20 records of the chunks decoded in slices.
+    EXPECT_GE(sliced.blocks, GetParam().points / 20 / 2) << "slices were not used";
+
+    LazStreaming batches;
+    batches.batchBytes = 5 << 20; // a few default chunks a batch
+    const Records batched = decodeLaz(lazPath, batches);
+    EXPECT_TRUE(sameRecords(batched, reference));
 }
 
 INSTANTIATE_TEST_SUITE_P(
