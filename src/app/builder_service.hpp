@@ -39,7 +39,7 @@ public:
     PipelineOptions options() const { return m_options; }
     void setOptions(const PipelineOptions& options) { m_options = options; }
 
-    // Starts pipeline 1 (PLY/LAS/XYZ) or 2 (.oms) for `path`. What File -> Open calls.
+    // Starts pipeline 1 (PLY/LAS/LAZ/XYZ) or 2 (.oms) for `path`. What File -> Open calls.
     void open(const QString& path);
     // Starts the built-in generated scene (pipeline 1 from memory).
     void openGeneratedScene(std::uint64_t points = kDefaultScenePoints,

@@ -171,8 +171,9 @@ void MainWindow::connectActions() {
     connect(m_ui->actionOpen, &QAction::triggered, this, [this] {
         const QString path = QFileDialog::getOpenFileName(
             this, tr("Open"), m_recentFiles.value(0),
-            tr("Point clouds and hierarchies (*.ply *.las *.xyz *.pts *.txt *.csv *.oms *.omh);;"
-               "Point clouds (*.ply *.las *.xyz *.pts *.txt *.csv);;"
+            tr("Point clouds and hierarchies (*.ply *.las *.laz *.xyz *.pts *.txt *.csv *.oms "
+               "*.omh);;"
+               "Point clouds (*.ply *.las *.laz *.xyz *.pts *.txt *.csv);;"
                "Sorted streams (*.oms);;Hierarchies (*.omh);;All files (*)"));
         if (!path.isEmpty()) {
             openFile(path);

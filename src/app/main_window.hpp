@@ -61,7 +61,7 @@ public:
     void applyDefaultDockSizes(QSize window);
 
 public slots:
-    // What File -> Open does after its dialog: pipeline 1 (PLY/LAS/XYZ), 2 (.oms) or 3 (.omh).
+    // What File -> Open does after its dialog: pipeline 1 (PLY/LAS/LAZ/XYZ), 2 (.oms) or 3 (.omh).
     void openFile(const QString& path);
     void openDefaultScene(quint64 points = kDefaultScenePoints);
     void saveHierarchy(const QString& path);

@@ -162,7 +162,7 @@ const Command& buildCommand() {
         "                   [--threads T] [--chunks K] [--store exact|packed] [--save OUT.omh]\n"
         "                   [--memory-budget SIZE] [--temp-dir DIR] [--json]",
         "Builds the octree bottom-up with oblique hierarchy cuts while the input streams in:\n"
-        "an unsorted cloud (PLY, LAS, XYZ) goes through the incremental Morton sorter first\n"
+        "an unsorted cloud (PLY, LAS, LAZ, XYZ) goes through the incremental Morton sorter first\n"
         "(pipeline 1), a sorted stream (.oms) feeds the builder directly (pipeline 2).\n"
         "\n"
         "  --depth D          hierarchy depth l_max, 1..21 (default 7)\n"

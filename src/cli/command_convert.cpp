@@ -103,7 +103,7 @@ const Command& convertCommand() {
     static const Command command{
         "convert", "convert a cloud to PLY, LAS, XYZ or a .oms sorted stream",
         "convert IN OUT [--memory-budget SIZE] [--temp-dir DIR]",
-        "Reads IN (PLY, LAS, XYZ text or .oms) and writes OUT in the format its extension\n"
+        "Reads IN (PLY, LAS, LAZ, XYZ text or .oms) and writes OUT in the format its extension\n"
         "names: .ply (binary little-endian, float coordinates against a 'comment offset'),\n"
         "LAS 1.2 point format 3 (.las, millimetre steps or finer), XYZ text (.xyz, .txt) or a\n"
         "Morton-sorted stream (.oms, from a cloud that is not one already). Points keep\n"

@@ -184,8 +184,8 @@ const Command& infoCommand() {
     static const Command command{
         "info", "read a point cloud and describe it (format, count, bounds, speed)",
         "info FILE [--json] [--verify]",
-        "Reads the whole file (PLY, LAS, XYZ text or a .oms sorted stream, whose checksums and\n"
-        "Morton order are verified), streaming, and prints its format, the\n"
+        "Reads the whole file (PLY, LAS, LAZ, XYZ text or a .oms sorted stream, whose\n"
+        "checksums and Morton order are verified), streaming, and prints its format, the\n"
         "declared and read point counts, the attributes, the bounding box in source units,\n"
         "the source offset, the unit-cube transform, skipped non-finite points and the read\n"
         "speed.\n"

@@ -52,7 +52,7 @@ const Command& sortCommand() {
     static const Command command{
         "sort", "sort a cloud in Morton order into a sorted stream file (.oms)",
         "sort IN OUT.oms [--chunks K] [--threads T] [--memory-budget SIZE] [--temp-dir DIR]",
-        "Reads IN (PLY, LAS or XYZ), sorts its points by their level-21 Morton code in the\n"
+        "Reads IN (PLY, LAS, LAZ or XYZ), sorts its points by their level-21 Morton code in the\n"
         "cube of its bounding box (origin = min corner, edge = largest extent) and writes the\n"
         "sorted stream OUT.oms (docs/FORMATS.md) while sorted chunks come out. OUT is written\n"
         "to a temporary file and renamed at the end: a failed sort leaves no partial file.\n"

@@ -188,7 +188,7 @@ const Command& tileCommand() {
         "Copies fill a near-square grid (ceil(sqrt N) columns along x, rows along y), each\n"
         "shifted by whole extents of IN plus G; each keeps IN's point order and attributes.\n"
         "IN is read once to count its points, then once per copy.\n\n"
-        "  IN           any cloud (PLY, LAS, XYZ)\n"
+        "  IN           any cloud (PLY, LAS, LAZ, XYZ)\n"
         "  OUT          .ply (binary float, against an offset comment) or .las (LAS 1.2\n"
         "               format 3, LAS 1.4 format 7 past 2^32 points; 1 mm steps; no normals)\n"
         "  --copies N   1 to 1000000\n"

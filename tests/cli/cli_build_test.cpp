@@ -78,7 +78,9 @@ TEST_P(CliBuildSharedData, LevelsMatchABruteForceOctree) {
 INSTANTIATE_TEST_SUITE_P(Files, CliBuildSharedData,
                          ::testing::Values("bunny.ply", "autzen_trim.las", "autzen_trim.ply",
                                            "lion.ply", "sorvilier.ply", "indoor.ply", "dragon.ply",
-                                           "autzen_south.ply"),
+                                           "autzen_south.ply", "laz/autzen_trim.laz",
+                                           "laz/terrascan_fmt8.laz",
+                                           "laz/1.2-with-color.copc.laz"),
                          test::FileParamName());
 
 TEST(CliBuild, PaperCollapseCountsDroppedPointsAndBadOptionsExitTwo) {

@@ -100,7 +100,11 @@ INSTANTIATE_TEST_SUITE_P(Files, CliInfoSharedData,
                                            SharedFileCount{"sorvilier.ply", "498868"},
                                            SharedFileCount{"indoor.ply", "808042"},
                                            SharedFileCount{"dragon.ply", "437645"},
-                                           SharedFileCount{"autzen_south.ply", "4844261"}),
+                                           SharedFileCount{"autzen_south.ply", "4844261"},
+                                           SharedFileCount{"laz/autzen_trim.laz", "110000"},
+                                           SharedFileCount{"laz/simple.laz", "1065"},
+                                           SharedFileCount{"laz/1.2-with-color.copc.laz", "1065"},
+                                           SharedFileCount{"laz/terrascan_fmt8.laz", "697721"}),
                          [](const auto& info) { return test::fileParamName(info.param.name); });
 
 TEST(CliInfo, UnderstandsSortedStreams) {

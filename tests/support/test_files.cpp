@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <fstream>
 #include <stdexcept>
 #include <unistd.h>
@@ -29,7 +30,12 @@ std::string sharedDataFile(const std::string& name) {
 }
 
 std::string fileParamName(std::string fileName) {
-    std::replace(fileName.begin(), fileName.end(), '.', '_');
+    // Test names allow letters, digits and '_' only ("laz/a-b.laz" -> "laz_a_b_laz").
+    for (char& c : fileName) {
+        if (!std::isalnum(static_cast<unsigned char>(c))) {
+            c = '_';
+        }
+    }
     return fileName;
 }
 

@@ -33,7 +33,8 @@ std::string sharedDataFile(const std::string& name);
         GTEST_SKIP() << "shared data file " << (NAME) << " is absent (../shared/data); skipped";   \
     }
 
-// A parameterised test's name for a data file name: "bunny.ply" -> "bunny_ply".
+// A parameterised test's name for a data file name: "bunny.ply" -> "bunny_ply",
+// "laz/a-b.laz" -> "laz_a_b_laz".
 std::string fileParamName(std::string fileName);
 // The same as INSTANTIATE_TEST_SUITE_P's name generator, for tests parameterised by file name.
 struct FileParamName {

@@ -15,6 +15,7 @@ const char* toString(InputErrorKind kind) {
     case InputErrorKind::MalformedValue: return "malformed value";
     case InputErrorKind::OutOfBounds: return "out of bounds";
     case InputErrorKind::NoPoints: return "no points";
+    case InputErrorKind::CorruptData: return "corrupt data";
     }
     return "unknown error";
 }

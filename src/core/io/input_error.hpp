@@ -20,6 +20,7 @@ enum class InputErrorKind {
     MalformedValue,     // a text value that is not a number, a wrong number of columns
     OutOfBounds,        // a point outside the bounding box the header declares
     NoPoints,           // a well-formed file without a single finite point
+    CorruptData,        // compressed data (a LAZ chunk or chunk table) that does not decode
 };
 
 const char* toString(InputErrorKind kind);

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 
@@ -29,6 +30,8 @@ const char* toString(CloudFormat format) {
         return "PLY binary big-endian";
     case CloudFormat::Las:
         return "LAS";
+    case CloudFormat::Laz:
+        return "LAZ";
     case CloudFormat::Xyz:
         return "XYZ text";
     }
@@ -64,6 +67,33 @@ CloudFormat plyVariant(const std::string& path, FileStream& stream) {
                      "line after 'ply'");
 }
 
+// LAZ writers mark the point format byte with bit 7 (or 6); the LAS reader also recognises a
+// LAZ file by its 'laszip encoded' record when a writer left the byte plain.
+CloudFormat lasVariant(FileStream& stream) {
+    constexpr std::uint64_t kPointFormatByte = 104;
+    std::uint8_t format = 0;
+    stream.seek(kPointFormatByte);
+    if (stream.read(&format, 1) == 1 && (format & 0xC0) != 0) {
+        return CloudFormat::Laz;
+    }
+    return CloudFormat::Las;
+}
+
+std::string printableMagic(const char* bytes, std::size_t count) {
+    std::string text;
+    for (std::size_t i = 0; i < count; ++i) {
+        const auto c = static_cast<unsigned char>(bytes[i]);
+        if (c >= 0x20 && c < 0x7f) {
+            text += static_cast<char>(c);
+        } else {
+            char escaped[8];
+            std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
+            text += escaped;
+        }
+    }
+    return text;
+}
+
 } // namespace
 
 CloudFormat detectFormat(const std::string& path) {
@@ -79,19 +109,19 @@ CloudFormat detectFormat(const std::string& path) {
         return plyVariant(path, stream);
     }
     if (got == 4 && std::memcmp(magic.data(), "LASF", 4) == 0) {
-        return CloudFormat::Las; // LAZ shares the signature; the LAS reader rejects it
+        return lasVariant(stream);
     }
     if (extension == ".laz") {
-        throw InputError(InputErrorKind::UnsupportedFeature, path, InputLocation::none(),
-                         "LAZ (compressed LAS) is not supported; decompress it first, e.g. "
-                         "'laszip -i FILE.laz -o FILE.las' or 'pdal translate FILE.laz FILE.las'");
+        throw InputError(InputErrorKind::UnknownFormat, path, InputLocation::byte(0),
+                         "expected a LAZ file (compressed LAS, 'LASF' magic), found '" +
+                             printableMagic(magic.data(), got) + "'");
     }
     if (extension == ".xyz" || extension == ".pts" || extension == ".txt" || extension == ".csv") {
         return CloudFormat::Xyz;
     }
     throw InputError(InputErrorKind::UnknownFormat, path, InputLocation::byte(0),
-                     "unrecognised file: expected a PLY ('ply' magic), LAS ('LASF' magic) or "
-                     "XYZ text file (.xyz, .pts, .txt, .csv)");
+                     "unrecognised file: expected a PLY ('ply' magic), LAS or LAZ ('LASF' "
+                     "magic) or XYZ text file (.xyz, .pts, .txt, .csv)");
 }
 
 std::unique_ptr<PointReader> openPointCloud(const std::string& path, const OpenOptions& options) {
@@ -101,7 +131,8 @@ std::unique_ptr<PointReader> openPointCloud(const std::string& path, const OpenO
     case CloudFormat::PlyBinaryBigEndian:
         return openPlyReader(path, options);
     case CloudFormat::Las:
-        return openLasReader(path, options);
+    case CloudFormat::Laz:
+        return openLasReader(path, options); // the header decides; both are LAS records
     case CloudFormat::Xyz:
         return openXyzReader(path, options);
     }

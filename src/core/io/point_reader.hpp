@@ -1,4 +1,4 @@
-// Streaming point-cloud readers: one interface for PLY, LAS and XYZ text.
+// Streaming point-cloud readers: one interface for PLY, LAS, LAZ and XYZ text.
 //
 // Opening a file parses its header and, when the header has no bounding box (PLY, XYZ), runs a
 // bounds pre-pass over the positions, so that every batch read() delivers is already in the
@@ -22,7 +22,7 @@
 
 namespace omicron {
 
-enum class CloudFormat { PlyAscii, PlyBinaryLittleEndian, PlyBinaryBigEndian, Las, Xyz };
+enum class CloudFormat { PlyAscii, PlyBinaryLittleEndian, PlyBinaryBigEndian, Las, Laz, Xyz };
 
 const char* toString(CloudFormat format);
 
@@ -104,9 +104,9 @@ protected:
     CloudInfo m_info;
 };
 
-// Identifies the format by magic bytes ("ply", "LASF"), then by extension (.xyz .pts .txt
-// .csv); throws InputError for missing/unreadable files, directories, empty files, LAZ and
-// anything else unrecognised.
+// Identifies the format by magic bytes ("ply", "LASF": LAZ when the point format byte has a
+// compression bit), then by extension (.xyz .pts .txt .csv); throws InputError for
+// missing/unreadable files, directories, empty files and anything else unrecognised.
 CloudFormat detectFormat(const std::string& path);
 
 // Opens any supported cloud (header parsed, bounds known); throws InputError, or

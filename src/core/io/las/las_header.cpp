@@ -23,10 +23,6 @@ constexpr std::array<std::uint16_t, kMaxPointFormat + 1> kMinimumRecordLengths =
 constexpr std::array<std::uint8_t, kMaxPointFormat + 1> kColorOffsets = {0, 0,  20, 28, 0, 28,
                                                                          0, 30, 30, 0,  30};
 
-constexpr const char* kLazAdvice =
-    "LAZ (compressed LAS) is not supported; decompress it first, e.g. "
-    "'laszip -i FILE.laz -o FILE.las' or 'pdal translate FILE.laz FILE.las'";
-
 template <typename T> T load(const std::uint8_t* bytes) {
     T value;
     std::memcpy(&value, bytes, sizeof value);
@@ -64,7 +60,7 @@ public:
         checkHeaderSize();
         checkPointFormat();
         checkPointDataOffset();
-        rejectLaszipRecord();
+        findLaszipRecord();
         checkRecordLength();
         checkScaleAndOffset();
         readPointCount();
@@ -127,12 +123,9 @@ private:
     }
 
     void checkPointFormat() {
-        const std::uint8_t declared = m_bytes[field::pointFormat];
-        if ((declared & 0xC0) != 0) {
-            fail(InputErrorKind::UnsupportedFeature, field::pointFormat,
-                 "point data format byte " + std::to_string(declared) +
-                     " has a compression bit (6 or 7) set: " + kLazAdvice);
-        }
+        const std::uint8_t byte = m_bytes[field::pointFormat];
+        m_header.compressed = (byte & 0xC0) != 0;
+        const std::uint8_t declared = byte & 0x3F;
         if (declared > kMaxPointFormat) {
             fail(InputErrorKind::MalformedHeader, field::pointFormat,
                  "unknown point data format " + std::to_string(declared) + ", expected 0 to 10");
@@ -156,9 +149,21 @@ private:
         }
     }
 
-    // LAZ writers may leave the format byte plain but always add the laszip VLR. The walk is
-    // lenient: it stops at the first record that does not fit before the point data.
-    void rejectLaszipRecord() {
+    // LAZ writers set a compression bit in the format byte (or, rarely, leave it plain) and
+    // always add the laszip VLR. The walk is lenient: it stops at the first record that does
+    // not fit before the point data.
+    void findLaszipRecord() {
+        const bool bitSet = m_header.compressed;
+        walkRecords();
+        if (bitSet && m_header.laszipRecordOffset == 0) {
+            fail(InputErrorKind::MalformedHeader, field::pointFormat,
+                 "the point data format byte " + std::to_string(m_bytes[field::pointFormat]) +
+                     " marks a LAZ (compressed) file, but the file has no 'laszip encoded' "
+                     "variable length record (record id 22204) to say how it is compressed");
+        }
+    }
+
+    void walkRecords() {
         const std::uint32_t vlrCount = load<std::uint32_t>(&m_bytes[field::vlrCount]);
         std::uint64_t position = m_header.headerSize;
         std::array<std::uint8_t, kVlrHeaderSize> vlr{};
@@ -170,11 +175,14 @@ private:
             m_stream.readExact(vlr.data(), vlr.size(), "a variable length record header");
             const char* userId = reinterpret_cast<const char*>(&vlr[2]);
             const std::uint16_t recordId = load<std::uint16_t>(&vlr[18]);
+            const std::uint16_t length = load<std::uint16_t>(&vlr[20]);
             if (recordId == kLaszipRecordId && std::strncmp(userId, "laszip encoded", 16) == 0) {
-                fail(InputErrorKind::UnsupportedFeature, position,
-                     std::string("the file has a 'laszip encoded' record: ") + kLazAdvice);
+                m_header.compressed = true;
+                m_header.laszipRecordOffset = position + kVlrHeaderSize;
+                m_header.laszipRecordLength = length;
+                return;
             }
-            position += kVlrHeaderSize + load<std::uint16_t>(&vlr[20]);
+            position += kVlrHeaderSize + length;
         }
     }
 
@@ -239,6 +247,9 @@ private:
 
     // Bytes after the last record are allowed (LAS 1.4 EVLRs follow the points).
     void checkFileHoldsEveryRecord() {
+        if (m_header.compressed) {
+            return; // chunks of any size: the LAZ reader checks them
+        }
         const std::uint64_t fileSize = m_stream.size();
         const std::uint64_t available =
             (fileSize - m_header.pointDataOffset) / m_header.recordLength;

@@ -1,7 +1,7 @@
 // The LAS public header block (versions 1.0 to 1.4) and the point record layouts of point data
 // formats 0 to 10: where the fields are, shared by the reader and the writer, and the parse
-// that validates a file's header before any point is read. Uncompressed LAS only: LAZ is
-// recognised and refused with advice on how to decompress it.
+// that validates a file's header before any point is read. A LAZ file (compressed LAS) has the
+// same header; the parse finds its 'laszip encoded' record and leaves the points to io/laz.
 #pragma once
 
 #include "io/file_stream.hpp"
@@ -76,6 +76,11 @@ struct Header {
     glm::dvec3 scale{1.0};          // finite, non-zero
     glm::dvec3 offset{0.0};         // finite
     Bounds declaredBounds;          // as the header states them; see hasUsableBounds()
+    // LAZ: the point format byte has a compression bit (6 or 7) or the file has the 'laszip
+    // encoded' record; pointFormat is the format with those bits cleared.
+    bool compressed = false;
+    std::uint64_t laszipRecordOffset = 0; // byte of the record's payload (compressed only)
+    std::uint16_t laszipRecordLength = 0; // payload bytes
 
     // True when the declared bounds are finite with min <= max on every axis.
     bool hasUsableBounds() const;
@@ -88,10 +93,12 @@ struct Header {
 
 // Reads the public header block of `stream` and checks it against the file: signature,
 // version (1.0 to 1.4), header size, point format, record length, scale and offset, the
-// offset to the point data, the point count and that the file is long enough for every
-// record (trailing bytes, such as LAS 1.4 EVLRs, are allowed). Throws InputError naming the
-// field's byte offset: MalformedHeader, UnsupportedFeature (a newer version, LAZ), Truncated,
-// CountMismatch (LAS 1.4 legacy and 64-bit counts disagree) or NoPoints.
+// offset to the point data, the point count and, uncompressed, that the file is long enough
+// for every record (trailing bytes, such as LAS 1.4 EVLRs, are allowed; a LAZ file's chunks
+// are checked by its reader). Throws InputError naming the field's byte offset:
+// MalformedHeader (also: a LAZ compression bit without the 'laszip encoded' record),
+// UnsupportedFeature (a newer version), Truncated, CountMismatch (LAS 1.4 legacy and 64-bit
+// counts disagree) or NoPoints.
 Header readHeader(FileStream& stream);
 
 } // namespace omicron::las

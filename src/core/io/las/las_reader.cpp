@@ -2,7 +2,9 @@
 
 #include "io/file_stream.hpp"
 #include "io/input_error.hpp"
+#include "io/las/las_file_records.hpp"
 #include "io/las/las_header.hpp"
+#include "io/laz/laz_records.hpp"
 #include "io/pre_pass_monitor.hpp"
 #include "io/source_normalizer.hpp"
 
@@ -10,7 +12,8 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <vector>
+#include <filesystem>
+#include <memory>
 
 static_assert(std::endian::native == std::endian::little,
               "LAS records are little-endian and are decoded with memcpy loads");
@@ -18,9 +21,6 @@ static_assert(std::endian::native == std::endian::little,
 namespace omicron {
 
 namespace {
-
-// Records are read in blocks of whole records of about this size.
-constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
 
 // How many records, spread evenly over the file, decide the colour depth.
 constexpr std::uint64_t kColorSampleRecords = 4096;
@@ -38,12 +38,16 @@ enum class ColorDepth {
     SixteenBit,            // some sampled channel > 255: scaled by 1/257, rounded
 };
 
+// Turns LAS point records into points, whatever their source (plain records, or LAZ chunks
+// decoded by io/laz).
 class LasReader final : public PointReader {
 public:
-    LasReader(const std::string& path, const OpenOptions& options)
-        : m_stream(path), m_header(las::readHeader(m_stream)) {
+    LasReader(const std::string& path, const las::Header& header,
+              std::unique_ptr<LasRecordSource> records, CloudFormat format,
+              const OpenOptions& options)
+        : m_header(header), m_records(std::move(records)), m_fileBytes(fileSize(path)) {
         m_info.path = path;
-        m_info.format = CloudFormat::Las;
+        m_info.format = format;
         m_info.pointCount = m_header.pointCount;
         m_info.sourceOffset = m_header.offset;
         m_info.attributes.add(Attribute::Intensity);
@@ -67,6 +71,12 @@ public:
     ReadSummary read(const BatchConsumer& consumer, const ReadOptions& options) override;
 
 private:
+    static std::uint64_t fileSize(const std::string& path) {
+        std::error_code error;
+        const std::uintmax_t size = std::filesystem::file_size(path, error);
+        return error ? 0 : static_cast<std::uint64_t>(size);
+    }
+
     glm::dvec3 sourcePosition(const std::uint8_t* record) const {
         return glm::dvec3(load<std::int32_t>(record), load<std::int32_t>(record + 4),
                           load<std::int32_t>(record + 8)) *
@@ -86,62 +96,39 @@ private:
         return {std::min(red, 255), std::min(green, 255), std::min(blue, 255)};
     }
 
-    // Calls visit(records, count, firstIndex) for consecutive blocks of whole records, in
-    // file order, until visit returns false.
-    template <typename Visit> void forEachBlock(Visit&& visit) {
-        const std::uint64_t stride = m_header.recordLength;
-        const std::uint64_t recordsPerBlock = std::max<std::uint64_t>(1, kBlockBytes / stride);
-        m_block.resize(static_cast<std::size_t>(recordsPerBlock * stride));
-        m_stream.seek(m_header.pointDataOffset);
-        for (std::uint64_t first = 0; first < m_header.pointCount; first += recordsPerBlock) {
-            const std::uint64_t count = std::min(recordsPerBlock, m_header.pointCount - first);
-            m_stream.readExact(m_block.data(), static_cast<std::size_t>(count * stride),
-                               "point records " + std::to_string(first) + " to " +
-                                   std::to_string(first + count - 1) + " (counting from 0, " +
-                                   std::to_string(stride) + " bytes each)");
-            if (!visit(m_block.data(), count, first)) {
-                return;
-            }
-        }
-    }
-
     // Only when the header's bounds are unusable (NaN, min > max): one pass over the records.
     Bounds boundsPrePass(const OpenOptions& options) {
         Bounds bounds;
-        PrePassMonitor monitor(options, m_stream.path(), m_stream.size(), m_header.pointCount);
+        PrePassMonitor monitor(options, m_info.path, m_fileBytes, m_header.pointCount);
         monitor.advance(m_header.pointDataOffset);
-        forEachBlock([&](const std::uint8_t* records, std::uint64_t count, std::uint64_t first) {
-            for (std::uint64_t i = 0; i < count; ++i) {
-                const glm::dvec3 source = sourcePosition(records + i * m_header.recordLength);
+        m_records->forEachBlock([&](const LasRecordBlock& block) {
+            for (std::uint64_t i = 0; i < block.count; ++i) {
+                const glm::dvec3 source = sourcePosition(block.records + i * m_header.recordLength);
                 bounds.extend(source);
-                if (monitor.samples(first + i)) {
+                if (monitor.samples(block.firstIndex + i)) {
                     monitor.offer(source);
                 }
             }
-            return monitor.reached(m_header.recordOffset(first + count));
+            return monitor.reached(block.endByte);
         });
         monitor.finish();
         return bounds;
     }
 
-    // The heuristic: read the colour of up to kColorSampleRecords records spread evenly over
-    // the file; if every sampled channel is <= 255 the file holds 8-bit values in its 16-bit
+    // The heuristic: read the colour of up to kColorSampleRecords records spread over the
+    // file; if every sampled channel is <= 255 the file holds 8-bit values in its 16-bit
     // fields, otherwise true 16-bit values. A sample keeps opening cheap on huge files.
     ColorDepth sampleColorDepth() {
-        const std::uint64_t samples = std::min(kColorSampleRecords, m_header.pointCount);
-        std::uint8_t rgb[6];
-        for (std::uint64_t s = 0; s < samples; ++s) {
-            const std::uint64_t index = s * m_header.pointCount / samples;
-            m_stream.seek(m_header.recordOffset(index) + m_colorOffset);
-            m_stream.readExact(rgb, sizeof rgb,
-                               "the colour of point record " + std::to_string(index));
-            for (int channel = 0; channel < 3; ++channel) {
-                if (load<std::uint16_t>(rgb + 2 * channel) > 255) {
-                    return ColorDepth::SixteenBit;
+        bool sixteenBit = false;
+        m_colorSamples =
+            m_records->sampleRecords(kColorSampleRecords, [&](const std::uint8_t* record) {
+                for (int channel = 0; channel < 3; ++channel) {
+                    if (load<std::uint16_t>(record + m_colorOffset + 2 * channel) > 255) {
+                        sixteenBit = true;
+                    }
                 }
-            }
-        }
-        return ColorDepth::EightBitIn16BitFields;
+            });
+        return sixteenBit ? ColorDepth::SixteenBit : ColorDepth::EightBitIn16BitFields;
     }
 
     std::string describeFormat() const {
@@ -153,9 +140,12 @@ private:
         if (extraBytes > 0) {
             detail += " (" + std::to_string(extraBytes) + " extra bytes)";
         }
+        const std::string storage = m_records->describe();
+        if (!storage.empty()) {
+            detail += ", " + storage;
+        }
         const std::string sampled =
-            " (judged from " + std::to_string(std::min(kColorSampleRecords, m_header.pointCount)) +
-            " sampled records)";
+            " (judged from " + std::to_string(m_colorSamples) + " sampled records)";
         if (m_colorDepth == ColorDepth::EightBitIn16BitFields) {
             detail += ", 8-bit colour in 16-bit fields" + sampled;
         } else if (m_colorDepth == ColorDepth::SixteenBit) {
@@ -166,21 +156,21 @@ private:
 
     [[noreturn]] void throwOutOfBounds(const SourceNormalizer& normalizer, std::uint64_t index,
                                        const glm::dvec3& source) const {
-        const InputLocation where = InputLocation::byte(m_header.recordOffset(index));
+        const InputLocation where = m_records->recordLocation(index);
         try {
             normalizer.throwOutOfBounds(m_info.path, where, source);
         } catch (const InputError& error) {
             throw InputError(error.kind(), m_info.path, where,
-                             "point record " + std::to_string(index) +
-                                 " (counting from 0): " + error.detail());
+                             m_records->recordName(index) + ": " + error.detail());
         }
     }
 
-    FileStream m_stream;
     las::Header m_header;
+    std::unique_ptr<LasRecordSource> m_records;
+    std::uint64_t m_fileBytes;
     ColorDepth m_colorDepth = ColorDepth::None;
+    std::uint64_t m_colorSamples = 0;
     std::size_t m_colorOffset = 0;
-    std::vector<std::uint8_t> m_block;
 };
 
 ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& options) {
@@ -213,12 +203,12 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
         summary.pointsDelivered += batch.size();
         batch.clear();
     };
-    forEachBlock([&](const std::uint8_t* records, std::uint64_t count, std::uint64_t first) {
-        for (std::uint64_t i = 0; i < count; ++i) {
-            const std::uint8_t* record = records + i * stride;
+    m_records->forEachBlock([&](const LasRecordBlock& block) {
+        for (std::uint64_t i = 0; i < block.count; ++i) {
+            const std::uint8_t* record = block.records + i * stride;
             const glm::dvec3 source = sourcePosition(record);
             if (!normalizer.inBounds(source)) {
-                throwOutOfBounds(normalizer, first + i, source);
+                throwOutOfBounds(normalizer, block.firstIndex + i, source);
             }
             batch.positions.push_back(
                 normalizer.toUnit(glm::clamp(source, bounds.min, bounds.max)));
@@ -228,7 +218,7 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
             }
             if (batch.size() == batchPoints) {
                 deliver();
-                const bool morePoints = first + i + 1 < m_header.pointCount;
+                const bool morePoints = block.firstIndex + i + 1 < m_header.pointCount;
                 if (morePoints && cancelled()) {
                     summary.cancelled = true;
                     return false;
@@ -246,7 +236,15 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
 } // namespace
 
 std::unique_ptr<PointReader> openLasReader(const std::string& path, const OpenOptions& options) {
-    return std::make_unique<LasReader>(path, options);
+    auto stream = std::make_unique<FileStream>(path);
+    const las::Header header = las::readHeader(*stream);
+    if (header.compressed) {
+        auto records = openLazRecords(std::move(stream), header);
+        return std::make_unique<LasReader>(path, header, std::move(records), CloudFormat::Laz,
+                                           options);
+    }
+    auto records = std::make_unique<LasFileRecords>(std::move(stream), header);
+    return std::make_unique<LasReader>(path, header, std::move(records), CloudFormat::Las, options);
 }
 
 } // namespace omicron

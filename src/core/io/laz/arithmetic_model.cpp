@@ -1,0 +1,85 @@
+#include "io/laz/arithmetic_model.hpp"
+
+#include <cassert>
+
+namespace omicron::laz {
+
+SymbolModel::SymbolModel(std::uint32_t symbolCountIn)
+    : symbols(symbolCountIn), lastSymbol(symbolCountIn - 1), distribution(symbolCountIn),
+      symbolCount(symbolCountIn, 1), updateCycle(symbolCountIn) {
+    assert(symbols >= 2 && symbols <= kMaxSymbols);
+    if (symbols > 16) {
+        // The table has 2^bits entries, bits chosen so that about four symbols share one.
+        std::uint32_t tableBits = 3;
+        while (symbols > (std::uint32_t{1} << (tableBits + 2))) {
+            ++tableBits;
+        }
+        tableSize = std::uint32_t{1} << tableBits;
+        tableShift = kSymbolLengthShift - tableBits;
+        decoderTable.resize(tableSize + 2);
+    }
+    // The first update turns the unit counts into a uniform distribution (total = symbols).
+    update();
+    symbolsUntilUpdate = updateCycle = (symbols + 6) >> 1;
+}
+
+void SymbolModel::update() {
+    totalCount += updateCycle;
+    if (totalCount > kSymbolMaxCount) {
+        totalCount = 0;
+        for (std::uint32_t& count : symbolCount) {
+            count = (count + 1) >> 1;
+            totalCount += count;
+        }
+    }
+    // scale * sum <= 2^31 because sum <= totalCount; a symbol's width is at least 1 unit
+    // because totalCount <= 2^15 here.
+    const std::uint32_t scale = 0x80000000u / totalCount;
+    std::uint32_t sum = 0;
+    if (tableSize == 0) {
+        for (std::uint32_t k = 0; k < symbols; ++k) {
+            distribution[k] = (scale * sum) >> (31 - kSymbolLengthShift);
+            sum += symbolCount[k];
+        }
+    } else {
+        std::uint32_t filled = 0;
+        for (std::uint32_t k = 0; k < symbols; ++k) {
+            distribution[k] = (scale * sum) >> (31 - kSymbolLengthShift);
+            sum += symbolCount[k];
+            const std::uint32_t slot = distribution[k] >> tableShift;
+            while (filled < slot) {
+                decoderTable[++filled] = k - 1;
+            }
+        }
+        decoderTable[0] = 0;
+        while (filled <= tableSize) {
+            decoderTable[++filled] = symbols - 1;
+        }
+    }
+    updateCycle = (5 * updateCycle) >> 2;
+    const std::uint32_t maxCycle = (symbols + 6) << 3;
+    if (updateCycle > maxCycle) {
+        updateCycle = maxCycle;
+    }
+    symbolsUntilUpdate = updateCycle;
+}
+
+void BitModel::update() {
+    bitCount += updateCycle;
+    if (bitCount > kBitMaxCount) {
+        bitCount = (bitCount + 1) >> 1;
+        bit0Count = (bit0Count + 1) >> 1;
+        if (bit0Count == bitCount) {
+            ++bitCount; // a 1 always keeps a non-zero probability
+        }
+    }
+    const std::uint32_t scale = 0x80000000u / bitCount;
+    bit0Probability = (bit0Count * scale) >> (31 - kBitLengthShift);
+    updateCycle = (5 * updateCycle) >> 2;
+    if (updateCycle > 64) {
+        updateCycle = 64;
+    }
+    bitsUntilUpdate = updateCycle;
+}
+
+} // namespace omicron::laz

@@ -1,0 +1,126 @@
+#include "io/laz/point10_decoder.hpp"
+
+#include "io/laz/return_contexts.hpp"
+
+#include <bit>
+#include <cstring>
+
+static_assert(std::endian::native == std::endian::little, "LAS fields are stored with memcpy");
+
+namespace omicron::laz {
+
+namespace {
+
+template <typename T> T load(const std::uint8_t* bytes) {
+    T value;
+    std::memcpy(&value, bytes, sizeof value);
+    return value;
+}
+
+template <typename T> void store(std::uint8_t* bytes, T value) {
+    std::memcpy(bytes, &value, sizeof value);
+}
+
+// Which fields changed, in the bit mask each point starts with.
+constexpr unsigned kReturnBitsChanged = 1u << 5;
+constexpr unsigned kIntensityChanged = 1u << 4;
+constexpr unsigned kClassificationChanged = 1u << 3;
+constexpr unsigned kScanAngleChanged = 1u << 2;
+constexpr unsigned kUserDataChanged = 1u << 1;
+constexpr unsigned kPointSourceChanged = 1u << 0;
+
+// The even part of k, at most `limit`: how a coordinate's magnitude class selects the next
+// coordinate's context.
+std::uint32_t evenClass(std::uint32_t k, std::uint32_t limit) {
+    return k < limit ? (k & ~1u) : limit;
+}
+
+} // namespace
+
+Point10Decoder::Point10Decoder() = default;
+
+SymbolModel& Point10Decoder::modelFor(ModelPerByte& models, std::uint8_t previous) {
+    std::unique_ptr<SymbolModel>& model = models[previous];
+    if (!model) {
+        model = std::make_unique<SymbolModel>(256);
+    }
+    return *model;
+}
+
+void Point10Decoder::start(const std::uint8_t* item) {
+    m_last.x = load<std::int32_t>(item);
+    m_last.y = load<std::int32_t>(item + 4);
+    m_last.z = load<std::int32_t>(item + 8);
+    // The first intensity is not a prediction: LASzip starts from 0 in every context.
+    m_last.intensity = 0;
+    m_last.returnBits = item[14];
+    m_last.classification = item[15];
+    m_last.scanAngleRank = item[16];
+    m_last.userData = item[17];
+    m_last.pointSourceId = load<std::uint16_t>(item + 18);
+}
+
+void Point10Decoder::decode(ArithmeticDecoder& decoder, std::uint8_t* item) {
+    const unsigned changed = decoder.decodeSymbol(m_changedValues);
+    if (changed & kReturnBitsChanged) {
+        m_last.returnBits = static_cast<std::uint8_t>(
+            decoder.decodeSymbol(modelFor(m_returnBits, m_last.returnBits)));
+    }
+    const std::uint32_t returnNumber = m_last.returnBits & 7u;
+    const std::uint32_t numberOfReturns = (m_last.returnBits >> 3) & 7u;
+    const std::uint32_t map = returnMap8(numberOfReturns, returnNumber);
+    const std::uint32_t level = returnLevel8(numberOfReturns, returnNumber);
+
+    if (changed & kIntensityChanged) {
+        m_last.intensity = static_cast<std::uint16_t>(
+            m_intensity.decode(decoder, m_lastIntensity[map], map < 3 ? map : 3));
+        m_lastIntensity[map] = m_last.intensity;
+    } else {
+        m_last.intensity = m_lastIntensity[map];
+    }
+    if (changed & kClassificationChanged) {
+        m_last.classification = static_cast<std::uint8_t>(
+            decoder.decodeSymbol(modelFor(m_classification, m_last.classification)));
+    }
+    if (changed & kScanAngleChanged) {
+        const unsigned scanDirection = (m_last.returnBits >> 6) & 1u;
+        const std::uint32_t delta = decoder.decodeSymbol(m_scanAngleRank[scanDirection]);
+        m_last.scanAngleRank = static_cast<std::uint8_t>(delta + m_last.scanAngleRank);
+    }
+    if (changed & kUserDataChanged) {
+        m_last.userData =
+            static_cast<std::uint8_t>(decoder.decodeSymbol(modelFor(m_userData, m_last.userData)));
+    }
+    if (changed & kPointSourceChanged) {
+        m_last.pointSourceId =
+            static_cast<std::uint16_t>(m_pointSourceId.decode(decoder, m_last.pointSourceId));
+    }
+
+    const std::uint32_t single = numberOfReturns == 1 ? 1 : 0;
+    const std::int32_t dx = m_dx.decode(decoder, m_xDiffMedian[map].median(), single);
+    m_last.x = static_cast<std::int32_t>(static_cast<std::uint32_t>(m_last.x) +
+                                         static_cast<std::uint32_t>(dx));
+    m_xDiffMedian[map].add(dx);
+
+    const std::int32_t dy =
+        m_dy.decode(decoder, m_yDiffMedian[map].median(), single + evenClass(m_dx.k(), 20));
+    m_last.y = static_cast<std::int32_t>(static_cast<std::uint32_t>(m_last.y) +
+                                         static_cast<std::uint32_t>(dy));
+    m_yDiffMedian[map].add(dy);
+
+    const std::uint32_t zClass = (m_dx.k() + m_dy.k()) / 2;
+    m_last.z = m_z.decode(decoder, m_lastHeight[level], single + evenClass(zClass, 18));
+    m_lastHeight[level] = m_last.z;
+
+    store(item, m_last.x);
+    store(item + 4, m_last.y);
+    store(item + 8, m_last.z);
+    store(item + 12, m_last.intensity);
+    item[14] = m_last.returnBits;
+    item[15] = m_last.classification;
+    item[16] = m_last.scanAngleRank;
+    item[17] = m_last.userData;
+    store(item + 18, m_last.pointSourceId);
+}
+
+} // namespace omicron::laz

@@ -1,0 +1,63 @@
+// The POINT14 item, versions 3 and 4: the 30 bytes every LAS 1.4 point record of formats 6 to
+// 10 starts with, in nine layers: (0) scanner channel, returns, x and y; (1) z;
+// (2) classification; (3) flags; (4) intensity; (5) scan angle; (6) user data; (7) point source
+// ID; (8) GPS time. The first layer's change mask says which fields changed; each field is
+// predicted in the context of the point's return number and number of returns, and whether its
+// GPS time changed, with separate models and predictions per scanner channel.
+#pragma once
+
+#include "io/laz/gpstime_decoder.hpp"
+#include "io/laz/layered_item_decoder.hpp"
+#include "io/laz/streaming_median.hpp"
+
+namespace omicron::laz {
+
+inline constexpr std::size_t kPoint14Bytes = 30;
+inline constexpr std::size_t kPoint14Layers = 9;
+
+class Point14Decoder final : public LayeredItemDecoder {
+public:
+    Point14Decoder();
+    ~Point14Decoder() override;
+
+    std::size_t layerCount() const override { return kPoint14Layers; }
+    void start(const std::uint8_t* firstItem, std::uint32_t channel,
+               std::span<Layer> layers) override;
+    // `channel` is ignored: POINT14 decodes it (see channel()).
+    void decode(std::uint8_t* item, std::uint32_t channel) override;
+
+    // The scanner channel of the last point decoded (or started from).
+    std::uint32_t channel() const { return m_current; }
+
+    // The scanner channel stored in a raw POINT14 item.
+    static std::uint32_t channelOf(const std::uint8_t* item) { return (item[15] >> 4) & 3u; }
+
+private:
+    struct Fields {
+        std::int32_t x = 0, y = 0, z = 0;
+        std::uint16_t intensity = 0;
+        std::uint32_t returnNumber = 0;    // 4 bits
+        std::uint32_t numberOfReturns = 0; // 4 bits
+        std::uint32_t classFlags = 0;      // 4 bits
+        std::uint32_t scannerChannel = 0;  // 2 bits
+        std::uint32_t scanDirection = 0;
+        std::uint32_t edgeOfFlightLine = 0;
+        std::uint8_t classification = 0;
+        std::uint8_t userData = 0;
+        std::int16_t scanAngle = 0;
+        std::uint16_t pointSourceId = 0;
+        std::uint64_t gpsTimeBits = 0;
+
+        static Fields load(const std::uint8_t* item);
+        void store(std::uint8_t* item) const;
+    };
+    struct Context;
+
+    Context& open(std::uint32_t channel, const Fields& from);
+
+    std::span<Layer> m_layers;
+    std::array<std::unique_ptr<Context>, 4> m_contexts;
+    std::uint32_t m_current = 0;
+};
+
+} // namespace omicron::laz

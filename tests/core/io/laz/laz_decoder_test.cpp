@@ -1,0 +1,153 @@
+// The LAZ decoder against an independent one: every record decoded from the real LAZ/COPC
+// files in ../shared/data/laz must equal, byte for byte, the record laz-perf decoded into the
+// reference LAS file (see that folder's README); and with 1 and 2 threads alike.
+#include "io/file_stream.hpp"
+#include "io/las/las_header.hpp"
+#include "io/laz/laz_records.hpp"
+#include "test_files.hpp"
+
+#include <cstring>
+#include <gtest/gtest.h>
+#include <string>
+#include <tbb/global_control.h>
+#include <vector>
+
+namespace omicron {
+namespace {
+
+struct Records {
+    las::Header header;
+    std::vector<std::uint8_t> bytes; // every record, in file order
+    std::uint64_t blocks = 0;
+};
+
+Records decodeLaz(const std::string& path, const LazStreaming& streaming = {}) {
+    auto stream = std::make_unique<FileStream>(path);
+    Records result;
+    result.header = las::readHeader(*stream);
+    EXPECT_TRUE(result.header.compressed);
+    auto records = openLazRecords(std::move(stream), result.header, streaming);
+    std::uint64_t nextIndex = 0;
+    records->forEachBlock([&](const LasRecordBlock& block) {
+        EXPECT_EQ(block.firstIndex, nextIndex);
+        nextIndex += block.count;
+        result.bytes.insert(result.bytes.end(), block.records,
+                            block.records + block.count * result.header.recordLength);
+        ++result.blocks;
+        return true;
+    });
+    return result;
+}
+
+Records readLas(const std::string& path) {
+    FileStream stream(path);
+    Records result;
+    result.header = las::readHeader(stream);
+    EXPECT_FALSE(result.header.compressed);
+    result.bytes.resize(result.header.pointCount * result.header.recordLength);
+    stream.seek(result.header.pointDataOffset);
+    stream.readExact(result.bytes.data(), result.bytes.size(), "the reference records");
+    return result;
+}
+
+// The first record that differs, as a readable failure.
+::testing::AssertionResult sameRecords(const Records& decoded, const Records& reference) {
+    const std::size_t length = reference.header.recordLength;
+    if (decoded.bytes.size() != reference.bytes.size()) {
+        return ::testing::AssertionFailure()
+               << "decoded " << decoded.bytes.size() / length << " records, the reference has "
+               << reference.bytes.size() / length;
+    }
+    for (std::size_t i = 0; i < decoded.bytes.size(); ++i) {
+        if (decoded.bytes[i] != reference.bytes[i]) {
+            return ::testing::AssertionFailure()
+                   << "record " << i / length << " differs first at its byte " << i % length
+                   << ": decoded " << int(decoded.bytes[i]) << ", reference "
+                   << int(reference.bytes[i]);
+        }
+    }
+    return ::testing::AssertionSuccess();
+}
+
+struct ReferencePair {
+    const char* laz;
+    const char* las;
+    std::uint8_t pointFormat;
+    std::uint64_t points;
+};
+
+void PrintTo(const ReferencePair& pair, std::ostream* out) {
+    *out << pair.laz << " vs " << pair.las;
+}
+
+class LazDecoder : public ::testing::TestWithParam<ReferencePair> {};
+
+TEST_P(LazDecoder, MatchesReferenceByteForByte) {
+    OMICRON_REQUIRE_SHARED_FILE(lazPath, GetParam().laz);
+    OMICRON_REQUIRE_SHARED_FILE(lasPath, GetParam().las);
+    const Records decoded = decodeLaz(lazPath);
+    const Records reference = readLas(lasPath);
+    EXPECT_EQ(decoded.header.pointFormat, GetParam().pointFormat);
+    EXPECT_EQ(decoded.header.pointCount, GetParam().points);
+    ASSERT_EQ(decoded.header.recordLength, reference.header.recordLength);
+    ASSERT_EQ(reference.header.pointCount, GetParam().points);
+    EXPECT_TRUE(sameRecords(decoded, reference));
+}
+
+TEST_P(LazDecoder, SameRecordsWithOneAndTwoThreads) {
+    OMICRON_REQUIRE_SHARED_FILE(lazPath, GetParam().laz);
+    Records one;
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        one = decodeLaz(lazPath);
+    }
+    Records two;
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+        two = decodeLaz(lazPath);
+    }
+    EXPECT_EQ(one.bytes.size(), GetParam().points * one.header.recordLength);
+    EXPECT_TRUE(sameRecords(one, two));
+}
+
+// The streaming limits change how chunks are grouped and split, never the records: batches of
+// a few chunks, and chunks too large for a batch decoded in slices of a few records.
+TEST_P(LazDecoder, SmallBatchesAndSlicesDecodeTheSameRecords) {
+    OMICRON_REQUIRE_SHARED_FILE(lazPath, GetParam().laz);
+    OMICRON_REQUIRE_SHARED_FILE(lasPath, GetParam().las);
+    const Records reference = readLas(lasPath);
+    const std::uint64_t recordLength = reference.header.recordLength;
+
+    LazStreaming slices;
+    slices.batchBytes = 4096; // most chunks are larger: decoded alone
+    slices.sliceBytes = 20 * recordLength;
+    const Records sliced = decodeLaz(lazPath, slices);
+    EXPECT_TRUE(sameRecords(sliced, reference));
+    // At least one block per 20 records of the chunks decoded in slices.
+    EXPECT_GE(sliced.blocks, GetParam().points / 20 / 2) << "slices were not used";
+
+    LazStreaming batches;
+    batches.batchBytes = 5 << 20; // a few default chunks a batch
+    const Records batched = decodeLaz(lazPath, batches);
+    EXPECT_TRUE(sameRecords(batched, reference));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    SharedLaz, LazDecoder,
+    ::testing::Values(ReferencePair{"laz/simple.laz", "laz/simple.las", 3, 1065},
+                      ReferencePair{"laz/autzen_trim.laz", "autzen_trim.las", 3, 110000},
+                      ReferencePair{"laz/1.2-with-color.copc.laz", "laz/1.2-with-color.copc.las", 7,
+                                    1065},
+                      ReferencePair{"laz/terrascan_fmt8.laz", "laz/terrascan_fmt8.las", 8, 697721}),
+    [](const ::testing::TestParamInfo<ReferencePair>& info) {
+        std::string name = info.param.laz + 4; // without "laz/"
+        for (char& c : name) {
+            if (c == '.' || c == '-') {
+                c = '_';
+            }
+        }
+        return name;
+    });
+
+} // namespace
+} // namespace omicron
