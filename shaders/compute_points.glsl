@@ -26,7 +26,8 @@ layout(r32ui, binding = 0) uniform coherent highp uimage2D u_depthImage;
 
 uniform mat4 u_view;
 uniform mat4 u_viewProjection;
-uniform float u_pixelsPerUnit;
+uniform float u_pixelsPerUnit; // orthographic: pixels per unit anywhere
+uniform bool u_orthographic;
 uniform float u_sizeScale;
 uniform float u_minPointPx;
 uniform float u_maxPointPx;
@@ -110,7 +111,7 @@ bool projectPoint(PointVertex p, out Footprint footprint) {
     // Distance along the view axis: minus the view-space z (third row of u_view).
     float viewZ = dot(vec4(u_view[0][2], u_view[1][2], u_view[2][2], u_view[3][2]),
                       vec4(p.position, 1.0));
-    float depth = max(-viewZ, 1e-7);
+    float depth = u_orthographic ? 1.0 : max(-viewZ, 1e-7);
     float radius = p.radius * u_sizeScale;
     footprint.sizePx = clamp(2.0 * radius * u_pixelsPerUnit / depth, u_minPointPx, u_maxPointPx);
     footprint.centrePx = (ndc.xy * 0.5 + 0.5) * vec2(u_viewportPx);

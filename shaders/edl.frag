@@ -9,17 +9,21 @@ uniform float u_radius;    // neighbour distance, pixels
 uniform float u_strength;  // 0: no shading
 uniform float u_p22;       // projection matrix [2][2] and [3][2]: linear depth from the buffer
 uniform float u_p32;
+uniform bool u_orthographic; // the depth buffer is linear already
 
 in vec2 v_uv;
 out vec4 fragColor;
 
-// log2 of the distance along the view axis (perspective projection); 0 for the background.
+// log2 of the distance along the view axis; 0 for the background. Orthographic: of the
+// distance from the far plane's opposite, kept positive (its differences are what shade).
 float logDepth(vec2 uv) {
     float depth = texture(u_depth, uv).r;
     if (depth >= 1.0) {
         return 0.0;
     }
-    float distance = u_p32 / (2.0 * depth - 1.0 + u_p22);
+    float ndc = 2.0 * depth - 1.0;
+    float distance = u_orthographic ? (ndc - u_p32) / -u_p22 + 2.0 / abs(u_p22)
+                                    : u_p32 / (ndc + u_p22);
     return log2(max(distance, 1e-6));
 }
 

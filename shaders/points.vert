@@ -7,7 +7,8 @@ layout(location = 3) in float a_radius;
 
 uniform mat4 u_view;
 uniform mat4 u_projection;
-uniform float u_pixelsPerUnit; // viewport height / (2 tan(fovY / 2))
+uniform float u_pixelsPerUnit; // viewport height / (2 tan(fovY / 2)); orthographic: per unit
+uniform bool u_orthographic;
 uniform float u_sizeScale;
 uniform float u_minPointPx;
 uniform float u_maxPointPx;
@@ -33,7 +34,7 @@ void main() {
     float radius = a_radius * u_sizeScale;
     viewPosition.z -= u_depthOffset * radius;
     gl_Position = u_projection * viewPosition;
-    float depth = max(-viewPosition.z, 1e-7);
+    float depth = u_orthographic ? 1.0 : max(-viewPosition.z, 1e-7);
     float pointPx = clamp(2.0 * radius * u_pixelsPerUnit / depth, u_minPointPx, u_maxPointPx);
     gl_PointSize = pointPx;
     v_pointPx = pointPx;

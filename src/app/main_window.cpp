@@ -312,6 +312,15 @@ void MainWindow::connectActions() {
     connect(m_ui->actionFlyMode, &QAction::toggled, m_view, &CloudView::setFlyMode);
     connect(m_view, &CloudView::flyModeChanged, m_ui->actionFlyMode, &QAction::setChecked);
     createMeasureTools();
+    // View → Orthographic Projection: sections and facades without perspective.
+    QAction* orthographic = new QAction(tr("&Orthographic Projection"), this);
+    orthographic->setObjectName(QStringLiteral("actionOrthographic"));
+    orthographic->setCheckable(true);
+    orthographic->setShortcut(QKeySequence(tr("O")));
+    orthographic->setStatusTip(tr("Parallel projection: parallel lines stay parallel (sections, "
+                                  "facades, plans); O switches back"));
+    m_ui->menuView->insertAction(m_ui->actionFlyMode, orthographic);
+    connect(orthographic, &QAction::toggled, m_view, &CloudView::setOrthographic);
     m_view->setHoverPicking(true);
     connect(m_view, &CloudView::pointHovered, this, [this](const PickedPoint& point) {
         m_pickLabel->setText(pickedPointText(point));

@@ -172,8 +172,8 @@ void CloudNode::evaluateFront(RenderContext& context) {
     FrontCamera camera;
     camera.viewProjection = context.projection * context.view;
     camera.eye = context.camera->eye();
-    camera.pixelsPerUnitAtUnitDistance =
-        context.camera->pixelsPerUnitAtUnitDistance(context.heightPx);
+    camera.pixelsPerUnitAtUnitDistance = context.camera->screenScale(context.heightPx);
+    camera.orthographic = context.camera->orthographic();
     if (settings.clip) {
         camera.clip = toUnitCube(*settings.clip, m_hierarchy->cloud().cube());
     }
@@ -329,9 +329,9 @@ void CloudNode::setCommonUniforms(QOpenGLShaderProgram& program, const RenderCon
                             QMatrix4x4(glm::value_ptr(glm::mat4(context.view))).transposed());
     program.setUniformValue("u_projection",
                             QMatrix4x4(glm::value_ptr(glm::mat4(context.projection))).transposed());
-    program.setUniformValue(
-        "u_pixelsPerUnit",
-        static_cast<float>(context.camera->pixelsPerUnitAtUnitDistance(context.heightPx)));
+    program.setUniformValue("u_pixelsPerUnit",
+                            static_cast<float>(context.camera->screenScale(context.heightPx)));
+    program.setUniformValue("u_orthographic", context.camera->orthographic());
     program.setUniformValue("u_sizeScale", settings.pointSizeScale);
     program.setUniformValue("u_minPointPx", kMinPointPx);
     program.setUniformValue("u_maxPointPx", kMaxPointPx);

@@ -118,8 +118,8 @@ public:
         context.targetFramebuffer = edl.framebuffer();
         scene.render(context, 0, 1);
         context.targetFramebuffer = framebuffer;
-        edl.composite(gl, framebuffer, context.projection, settings.edlStrength,
-                      settings.edlRadiusPx);
+        edl.composite(gl, framebuffer, context.projection, camera.orthographic(),
+                      settings.edlStrength, settings.edlRadiusPx);
         scene.render(context, 1, scene.size());
     }
 
@@ -400,6 +400,15 @@ void CloudView::setFlyMode(bool on) {
     }
     d->flyMode = on;
     emit flyModeChanged(on);
+}
+
+void CloudView::setOrthographic(bool on) {
+    d->camera.setOrthographic(on);
+    update();
+}
+
+bool CloudView::orthographic() const {
+    return d->camera.orthographic();
 }
 
 bool CloudView::flyMode() const {

@@ -49,6 +49,9 @@ public:
     void setStandardView(StandardView view);
     void setFlyMode(bool on);
     bool flyMode() const;
+    // Orthographic projection (the camera's, kept with it by camera()/setCamera()).
+    void setOrthographic(bool on);
+    bool orthographic() const;
 
     // Draws the cell of one node as a box over the cloud (magenta, through the points),
     // whatever the overlay settings: e.g. the node selected in a tree of the hierarchy.

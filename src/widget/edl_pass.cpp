@@ -71,7 +71,8 @@ bool EdlPass::begin(QOpenGLExtraFunctions& gl, int widthPx, int heightPx,
 }
 
 void EdlPass::composite(QOpenGLExtraFunctions& gl, unsigned framebuffer,
-                        const glm::dmat4& projection, float strength, float radiusPx) {
+                        const glm::dmat4& projection, bool orthographic, float strength,
+                        float radiusPx) {
     gl.glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
     gl.glViewport(0, 0, m_widthPx, m_heightPx);
     if (m_vao == 0) {
@@ -95,6 +96,7 @@ void EdlPass::composite(QOpenGLExtraFunctions& gl, unsigned framebuffer,
     m_program->setUniformValue("u_strength", strength);
     m_program->setUniformValue("u_p22", static_cast<float>(projection[2][2]));
     m_program->setUniformValue("u_p32", static_cast<float>(projection[3][2]));
+    m_program->setUniformValue("u_orthographic", orthographic);
     gl.glDrawArrays(GL_TRIANGLES, 0, 3);
     m_program->release();
     gl.glActiveTexture(GL_TEXTURE0);

@@ -21,10 +21,10 @@ public:
     bool begin(QOpenGLExtraFunctions& gl, int widthPx, int heightPx, const float background[3]);
     unsigned framebuffer() const { return m_framebuffer; }
 
-    // Draws the target into `framebuffer` with the shading; `projection` is the frame's
-    // (perspective), for the linear depth.
+    // Draws the target into `framebuffer` with the shading; `projection` is the frame's, for
+    // the linear depth.
     void composite(QOpenGLExtraFunctions& gl, unsigned framebuffer, const glm::dmat4& projection,
-                   float strength, float radiusPx);
+                   bool orthographic, float strength, float radiusPx);
 
 private:
     std::unique_ptr<QOpenGLShaderProgram> m_program;

@@ -41,8 +41,21 @@ glm::dmat4 ViewCamera::projectionMatrix(double aspect) const {
     const double centerDistance = glm::dot(center - eye(), forward());
     const double farPlane = std::max(centerDistance + radius * 1.5, 1e-3);
     // Near: close enough to fly inside the cloud, far enough for 24-bit depth (ratio <= 1e5).
+    if (m_orthographic) {
+        // As high as the perspective view at the pivot; depth is linear, so the near plane
+        // may sit behind the eye and keep the whole box.
+        const double halfHeight = m_distance * std::tan(m_fovY * 0.5);
+        const double halfWidth = halfHeight * std::max(aspect, 1e-3);
+        return glm::ortho(-halfWidth, halfWidth, -halfHeight, halfHeight,
+                          centerDistance - radius * 1.5, farPlane);
+    }
     const double nearPlane = std::max({centerDistance - radius * 1.5, farPlane * 1e-5, 1e-6});
     return glm::perspective(m_fovY, std::max(aspect, 1e-3), nearPlane, farPlane);
+}
+
+double ViewCamera::screenScale(double heightPx) const {
+    const double perspective = pixelsPerUnitAtUnitDistance(heightPx);
+    return m_orthographic ? perspective / std::max(m_distance, 1e-9) : perspective;
 }
 
 double ViewCamera::pixelsPerUnitAtUnitDistance(double heightPx) const {

@@ -30,6 +30,15 @@ public:
     glm::dmat4 projectionMatrix(double aspect) const;
     // Pixels covered by a unit length at unit distance, for a viewport `heightPx` high.
     double pixelsPerUnitAtUnitDistance(double heightPx) const;
+    // What a point's or a cell's size on screen is scaled by: pixels per unit at unit distance
+    // (then divided by the distance), or in an orthographic view pixels per unit anywhere
+    // (the view is as high as the perspective one's at the pivot).
+    double screenScale(double heightPx) const;
+
+    // Orthographic projection (parallel lines stay parallel: sections, facades, plans).
+    // Switching keeps the pivot's framing.
+    void setOrthographic(bool on) { m_orthographic = on; }
+    bool orthographic() const { return m_orthographic; }
 
     // The box the camera frames and clips against (the cloud's cube).
     void setSceneBox(const glm::dvec3& min, const glm::dvec3& max);
@@ -62,6 +71,7 @@ private:
     double m_fovY = kDefaultFovYDegrees * 3.14159265358979323846 / 180.0;
     glm::dvec3 m_boxMin{0.0};
     glm::dvec3 m_boxMax{1.0};
+    bool m_orthographic = false;
 };
 
 } // namespace omicron

@@ -352,6 +352,83 @@ private slots:
         }
     }
 
+    // Orthographic projection keeps parallel edges parallel and equally long on screen: two
+    // vertical edges of a cube (red at the corner nearest the iso view, green at the next
+    // one), seen from the iso view, differ in screen length with perspective and not without.
+    void orthographicKeepsParallelEdgesParallel() {
+        QTemporaryDir dir;
+        const QString path = dir.filePath(QStringLiteral("edges.ply"));
+        {
+            QFile file(path);
+            QVERIFY(file.open(QIODevice::WriteOnly | QIODevice::Text));
+            QTextStream out(&file);
+            out << "ply\nformat ascii 1.0\nelement vertex 808\nproperty float x\n"
+                   "property float y\nproperty float z\nproperty uchar red\n"
+                   "property uchar green\nproperty uchar blue\nend_header\n";
+            for (int i = 0; i <= 400; ++i) { // the two edges, and the cube's other corners
+                out << "0 0 " << i / 400.0 << " 255 0 0\n";
+                out << "1 0 " << i / 400.0 << " 0 255 0\n";
+            }
+            out << "1 1 0 0 0 255\n0 1 0 0 0 255\n1 1 1 0 0 255\n0 1 1 0 0 255\n"
+                   "0 0 0.5 255 0 0\n1 0 0.5 0 255 0\n";
+        }
+        CloudView view;
+        RenderSettings settings = plainSettings();
+        settings.projectionThresholdPx = 1.0; // every point, at the deepest level
+        settings.edl = EdlMode::Off;
+        view.setRenderSettings(settings);
+        view.setHierarchy(test::buildHierarchy(path, BuildOptions{}));
+        view.setStandardView(StandardView::Iso);
+        const auto screenHeights = [&](const QImage& image) {
+            int top[2] = {image.height(), image.height()}, bottom[2] = {-1, -1};
+            for (int y = 0; y < image.height(); ++y) {
+                for (int x = 0; x < image.width(); ++x) {
+                    const QColor c = image.pixelColor(x, y);
+                    const int edge = c.red() > 150 && c.green() < 80   ? 0
+                                     : c.green() > 150 && c.red() < 80 ? 1
+                                                                       : -1;
+                    if (edge >= 0) {
+                        top[edge] = std::min(top[edge], y);
+                        bottom[edge] = std::max(bottom[edge], y);
+                    }
+                }
+            }
+            return std::pair{bottom[0] - top[0], bottom[1] - top[1]};
+        };
+        const auto [redPerspective, greenPerspective] = screenHeights(view.renderImage(QSize(400, 400)));
+        QVERIFY(!view.orthographic());
+        view.setOrthographic(true);
+        QVERIFY(view.orthographic());
+        const auto [redOrtho, greenOrtho] = screenHeights(view.renderImage(QSize(400, 400)));
+        const QString trace = QStringLiteral("perspective %1 vs %2 px, orthographic %3 vs %4 px")
+                                  .arg(redPerspective)
+                                  .arg(greenPerspective)
+                                  .arg(redOrtho)
+                                  .arg(greenOrtho);
+        QVERIFY2(redOrtho > 50 && greenOrtho > 50, qPrintable(trace));
+        QVERIFY2(std::abs(redPerspective - greenPerspective) > 8, qPrintable(trace));
+        QVERIFY2(std::abs(redOrtho - greenOrtho) <= 2, qPrintable(trace));
+        // Picking works through the orthographic projection too (a shown view).
+        CloudView shown;
+        shown.setRenderSettings(settings);
+        shown.setHierarchy(test::buildHierarchy(path, BuildOptions{}));
+        shown.setStandardView(StandardView::Iso);
+        shown.setOrthographic(true);
+        shown.resize(400, 400);
+        shown.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&shown));
+        QTRY_VERIFY(shown.lastFrameStats().pointsDrawn > 0);
+        std::optional<PickedPoint> picked;
+        for (int y = 0; y < 400 && !picked; y += 2) {
+            for (int x = 0; x < 400 && !picked; x += 2) {
+                picked = shown.pickCloudPoint(QPoint(x, y));
+            }
+        }
+        QVERIFY(picked.has_value());
+        // A point of one of the edges or a corner of the cube, exactly.
+        QVERIFY(std::abs(picked->source.x - std::round(picked->source.x)) < 1e-5);
+    }
+
     void lionRendersInColourAndAsSplats() {
         const QString path = test::sharedDataFile("lion.ply");
         if (path.isEmpty()) {
