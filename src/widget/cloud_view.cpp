@@ -4,6 +4,7 @@
 #include "build/hierarchy.hpp"
 #include "cloud_node.hpp"
 #include "edl_pass.hpp"
+#include "scale_bar.hpp"
 #include "front/front_pick.hpp"
 #include "overlay_node.hpp"
 #include "sort/morton_sorter.hpp"
@@ -123,20 +124,33 @@ public:
         scene.render(context, 1, scene.size());
     }
 
-    // Each measurement's value beside it (QPainter over the frame: after the GL drawing).
-    void paintMeasurementLabels(CloudView& view) {
+    // What is painted over the GL frame with QPainter, in a `size` view (the widget, or a
+    // screenshot image): each measurement's value beside it, the scale bar and the north arrow.
+    void paintOverlays(QPainter& painter, const QSizeF& size, double heightPx) {
         const auto& hierarchy = cloud->hierarchy();
-        if (hierarchy == nullptr || (measurements.empty() && !draft)) {
+        if (hierarchy == nullptr) {
             return;
         }
         const CubeTransform& cube = hierarchy->cloud().cube();
         const glm::dmat4 viewProjection =
-            camera.projectionMatrix(static_cast<double>(view.width()) /
-                                    std::max(1, view.height())) *
+            camera.projectionMatrix(size.width() / std::max(1.0, size.height())) *
             camera.viewMatrix();
-        QPainter painter(&view);
+        const auto toScreen = [&](const glm::dvec3& unit) -> std::optional<QPointF> {
+            const glm::dvec4 clip = viewProjection * glm::dvec4(unit, 1.0);
+            if (clip.w <= 0.0) {
+                return std::nullopt; // behind the camera
+            }
+            return QPointF((clip.x / clip.w * 0.5 + 0.5) * size.width(),
+                           (0.5 - clip.y / clip.w * 0.5) * size.height());
+        };
         painter.setRenderHint(QPainter::Antialiasing);
         const QFontMetrics metrics(painter.font());
+        const auto textBox = [&](const QPointF& at, const QString& text, const QColor& color) {
+            const QRectF box(at, QSizeF(metrics.horizontalAdvance(text) + 8, metrics.height() + 4));
+            painter.fillRect(box, QColor(0, 0, 0, 170));
+            painter.setPen(color);
+            painter.drawText(box, Qt::AlignCenter, text);
+        };
         const auto label = [&](const Measurement& measurement) {
             if (measurement.points.size() < 2) {
                 return;
@@ -145,24 +159,58 @@ public:
             const glm::dvec3 middle =
                 (measurement.points[measurement.points.size() - 2] + measurement.points.back()) *
                 0.5;
-            const glm::dvec4 clip = viewProjection * glm::dvec4((middle - cube.origin) / cube.edge, 1.0);
-            if (clip.w <= 0.0) {
-                return; // behind the camera
+            if (const auto at = toScreen((middle - cube.origin) / cube.edge)) {
+                textBox(*at + QPointF(6, -metrics.height() - 4), measurement.valueText(),
+                        QColor(255, 220, 40));
             }
-            const QPointF at((clip.x / clip.w * 0.5 + 0.5) * view.width(),
-                             (0.5 - clip.y / clip.w * 0.5) * view.height());
-            const QString text = measurement.valueText();
-            QRectF box(at + QPointF(6, -metrics.height() - 4),
-                       QSizeF(metrics.horizontalAdvance(text) + 8, metrics.height() + 4));
-            painter.fillRect(box, QColor(0, 0, 0, 170));
-            painter.setPen(QColor(255, 220, 40));
-            painter.drawText(box, Qt::AlignCenter, text);
         };
         for (const Measurement& measurement : measurements) {
             label(measurement);
         }
         if (draft) {
             label(*draft);
+        }
+        if (settings.showScaleBar) {
+            // File units per pixel at the pivot (anywhere, in an orthographic view).
+            const double unitsPerPixel =
+                (camera.orthographic() ? 1.0 : camera.distance()) /
+                (camera.orthographic() ? camera.screenScale(heightPx)
+                                       : camera.pixelsPerUnitAtUnitDistance(heightPx)) *
+                cube.edge * (heightPx / size.height());
+            const ScaleBar bar = scaleBarFor(unitsPerPixel, size.width() / 6.0);
+            if (bar.widthPx > 0.0) {
+                const QPointF right(size.width() - 16.0, size.height() - 16.0);
+                const QPointF left = right - QPointF(bar.widthPx, 0.0);
+                painter.setPen(QPen(QColor(235, 235, 235), 2.0));
+                painter.drawLine(left, right);
+                painter.drawLine(left, left - QPointF(0, 6));
+                painter.drawLine(right, right - QPointF(0, 6));
+                textBox(QPointF(left.x() + (bar.widthPx - metrics.horizontalAdvance(bar.label) - 8) / 2,
+                                left.y() - metrics.height() - 12),
+                        bar.label, QColor(235, 235, 235));
+            }
+        }
+        const bool georeferenced =
+            std::max(std::abs(cube.origin.x), std::abs(cube.origin.y)) >= 1e4;
+        if (settings.showNorthArrow && georeferenced) {
+            // +y seen from the pivot, as a direction on screen.
+            const auto from = toScreen(camera.pivot());
+            const auto to = toScreen(camera.pivot() + glm::dvec3(0.0, 0.05, 0.0) * camera.distance());
+            if (from && to && *from != *to) {
+                QPointF direction = *to - *from;
+                direction /= std::hypot(direction.x(), direction.y());
+                const QPointF centre(size.width() - 36.0, 40.0);
+                const QPointF tip = centre + direction * 20.0;
+                const QPointF tail = centre - direction * 20.0;
+                const QPointF side(-direction.y() * 7.0, direction.x() * 7.0);
+                painter.setPen(QPen(QColor(235, 235, 235), 2.0));
+                painter.drawLine(tail, tip);
+                painter.setBrush(QColor(235, 235, 235));
+                painter.drawPolygon(QPolygonF({tip, tip - direction * 12.0 + side,
+                                               tip - direction * 12.0 - side}));
+                painter.drawText(QRectF(tip + direction * 12.0 - QPointF(8, 8), QSizeF(16, 16)),
+                                 Qt::AlignCenter, QStringLiteral("N"));
+            }
         }
     }
 
@@ -549,7 +597,10 @@ void CloudView::paintGL() {
     const int widthPx = std::max(1, static_cast<int>(std::lround(width() * ratio)));
     const int heightPx = std::max(1, static_cast<int>(std::lround(height() * ratio)));
     FrameStats stats = renderFrame(defaultFramebufferObject(), widthPx, heightPx, false);
-    d->paintMeasurementLabels(*this);
+    {
+        QPainter painter(this);
+        d->paintOverlays(painter, QSizeF(size()), heightPx);
+    }
 
     // Frames are drawn on demand: after a pause (no input, nothing to refine) a new window
     // starts with this frame, so the rate is that of rendering, not diluted by the idle time.
@@ -597,6 +648,8 @@ QImage CloudView::renderImage(const QSize& size) {
     QImage image = target.toImage(); // flipped: GL rows go bottom-up
     d->lastStats = stats;
     doneCurrent();
+    QPainter painter(&image); // labels, scale bar and north arrow in the image too
+    d->paintOverlays(painter, QSizeF(size), size.height());
     return image;
 }
 

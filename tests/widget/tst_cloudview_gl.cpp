@@ -2,6 +2,7 @@
 // pixel statistics of renderImage() from fixed cameras.
 #include "build/hierarchy_builder.hpp"
 #include "cloud_view.hpp"
+#include "scale_bar.hpp"
 #include "formats/omh_writer.hpp"
 #include "io/point_reader.hpp"
 #include "pipeline/build_pipeline.hpp"
@@ -25,6 +26,8 @@ RenderSettings plainSettings() {
     settings.showAxes = false;
     settings.showBoundingBox = false;
     settings.showCutBoundary = false;
+    settings.showScaleBar = false;
+    settings.showNorthArrow = false;
     return settings;
 }
 
@@ -427,6 +430,60 @@ private slots:
         QVERIFY(picked.has_value());
         // A point of one of the edges or a corner of the cube, exactly.
         QVERIFY(std::abs(picked->source.x - std::round(picked->source.x)) < 1e-5);
+    }
+
+    // The scale bar (bottom right) and, for a georeferenced cloud, the north arrow (top right)
+    // are painted over the frame and into screenshots; a cloud in local coordinates gets no
+    // arrow.
+    void scaleBarAndNorthArrowArePaintedWhereTheyBelong() {
+        const ScaleBar bar = scaleBarFor(0.37, 200.0);
+        QCOMPARE(bar.length, 50.0);
+        QCOMPARE(bar.label, QStringLiteral("50"));
+        QVERIFY(std::abs(bar.widthPx - 50.0 / 0.37) < 1e-9);
+        QCOMPARE(scaleBarFor(0.0013, 100.0).label, QStringLiteral("0.1"));
+
+        QTemporaryDir dir;
+        const QString path = dir.filePath(QStringLiteral("grid.ply"));
+        writeGrid(path, 0.0); // x = 500000 + i: georeferenced
+        CloudView view;
+        view.setHierarchy(test::buildHierarchy(path, BuildOptions{}));
+        view.setStandardView(StandardView::Top);
+        const auto differs = [](const QImage& a, const QImage& b, const QRect& region) {
+            int changed = 0;
+            for (int y = region.top(); y <= region.bottom(); ++y) {
+                for (int x = region.left(); x <= region.right(); ++x) {
+                    changed += a.pixel(x, y) != b.pixel(x, y) ? 1 : 0;
+                }
+            }
+            return changed;
+        };
+        const QRect bottomRight(300, 340, 100, 60), topRight(330, 0, 70, 80), middle(100, 100, 200, 200);
+        RenderSettings settings = plainSettings();
+        view.setRenderSettings(settings);
+        const QImage none = view.renderImage(QSize(400, 400));
+        settings.showScaleBar = true;
+        view.setRenderSettings(settings);
+        const QImage withBar = view.renderImage(QSize(400, 400));
+        QVERIFY(differs(none, withBar, bottomRight) > 50);
+        QCOMPARE(differs(none, withBar, topRight), 0);
+        QCOMPARE(differs(none, withBar, middle), 0);
+        settings.showScaleBar = false;
+        settings.showNorthArrow = true;
+        view.setRenderSettings(settings);
+        const QImage withArrow = view.renderImage(QSize(400, 400));
+        QVERIFY(differs(none, withArrow, topRight) > 30);
+        QCOMPARE(differs(none, withArrow, bottomRight), 0);
+
+        const QString bunny = test::sharedDataFile("bunny.ply");
+        if (!bunny.isEmpty()) { // local coordinates: no arrow
+            view.setHierarchy(test::buildHierarchy(bunny, BuildOptions{}));
+            settings.showNorthArrow = false;
+            view.setRenderSettings(settings);
+            const QImage local = view.renderImage(QSize(400, 400));
+            settings.showNorthArrow = true;
+            view.setRenderSettings(settings);
+            QCOMPARE(differs(local, view.renderImage(QSize(400, 400)), QRect(0, 0, 400, 400)), 0);
+        }
     }
 
     void lionRendersInColourAndAsSplats() {
