@@ -21,6 +21,8 @@
 #include <QFileInfo>
 #include <QGuiApplication>
 #include <QImage>
+#include <QInputDialog>
+#include <QLineEdit>
 #include <QLabel>
 #include <QLocale>
 #include <QMessageBox>
@@ -211,8 +213,32 @@ void MainWindow::connectActions() {
     });
     connect(m_ui->actionSaveScreenshot, &QAction::triggered, this, [this] {
         const QString path = askSavePath(tr("Save Screenshot"), tr("PNG images (*.png)"), "png");
-        if (!path.isEmpty() && !saveScreenshot(path)) {
-            showError(path, tr("%1: cannot write the screenshot").arg(path));
+        if (path.isEmpty()) {
+            return;
+        }
+        // The resolution: the view's, a multiple of it, or a print/video size.
+        const QSize view = m_view->size() * m_view->devicePixelRatio();
+        const QList<QSize> sizes = {view, view * 2, view * 4, QSize(1920, 1080),
+                                    QSize(3840, 2160), QSize(7680, 4320)};
+        QStringList choices;
+        for (int i = 0; i < sizes.size(); ++i) {
+            const QString size = QStringLiteral("%1 × %2").arg(sizes[i].width()).arg(sizes[i].height());
+            choices.append(i == 0 ? tr("%1 (the view)").arg(size)
+                           : i < 3 ? tr("%1 (%2× the view)").arg(size).arg(i == 1 ? 2 : 4)
+                                   : size);
+        }
+        bool ok = false;
+        const QString choice = QInputDialog::getItem(this, tr("Screenshot Resolution"),
+                                                     tr("Size of the image:"), choices, 0, false, &ok);
+        if (!ok) {
+            return;
+        }
+        const QSize size = sizes.value(static_cast<int>(choices.indexOf(choice)), view);
+        if (!saveScreenshot(path, size)) {
+            showError(path, tr("%1: cannot write the screenshot (%2 × %3)")
+                                .arg(path)
+                                .arg(size.width())
+                                .arg(size.height()));
         }
     });
     connect(m_ui->actionClearRecent, &QAction::triggered, this, [this] {
@@ -320,6 +346,10 @@ void MainWindow::connectActions() {
     orthographic->setStatusTip(tr("Parallel projection: parallel lines stay parallel (sections, "
                                   "facades, plans); O switches back"));
     m_ui->menuView->insertAction(m_ui->actionFlyMode, orthographic);
+    // View → Viewpoints: named cameras kept per file.
+    m_viewpointMenu = new QMenu(tr("View&points"), this);
+    m_ui->menuView->insertMenu(m_ui->actionFlyMode, m_viewpointMenu);
+    updateViewpointMenu();
     connect(orthographic, &QAction::toggled, m_view, &CloudView::setOrthographic);
     m_view->setHoverPicking(true);
     connect(m_view, &CloudView::pointHovered, this, [this](const PickedPoint& point) {
@@ -480,6 +510,8 @@ void MainWindow::connectService() {
 
 void MainWindow::openFile(const QString& path) {
     const QFileInfo info(path);
+    m_viewpointFile = info.absoluteFilePath();
+    updateViewpointMenu();
     // A .omh takes the memory budget only: beyond it, its points are paged in on demand.
     m_service->setOptions(m_buildPanel->pipelineOptions());
     if (info.suffix().compare(QStringLiteral("omh"), Qt::CaseInsensitive) == 0) {
@@ -490,7 +522,102 @@ void MainWindow::openFile(const QString& path) {
     addRecentFile(info.absoluteFilePath());
 }
 
+namespace {
+
+// Where a file's viewpoints are kept: one settings group per file path.
+QString viewpointKey(const QString& file) {
+    return QStringLiteral("viewpoints/") +
+           QString::fromLatin1(QUrl::toPercentEncoding(file.isEmpty() ? QStringLiteral("-")
+                                                                      : file));
+}
+
+} // namespace
+
+QStringList MainWindow::viewpointNames() const {
+    QStringList names = QSettings().value(viewpointKey(m_viewpointFile)).toMap().keys();
+    names.sort(Qt::CaseInsensitive);
+    return names;
+}
+
+void MainWindow::saveViewpoint(const QString& name) {
+    if (name.trimmed().isEmpty()) {
+        return;
+    }
+    const ViewCamera camera = m_view->camera();
+    const glm::dvec3 pivot = camera.pivot();
+    QSettings settings;
+    QVariantMap all = settings.value(viewpointKey(m_viewpointFile)).toMap();
+    all.insert(name.trimmed(), QVariantList{pivot.x, pivot.y, pivot.z, camera.distance(),
+                                            camera.yawRadians(), camera.pitchRadians(),
+                                            camera.orthographic()});
+    settings.setValue(viewpointKey(m_viewpointFile), all);
+    updateViewpointMenu();
+}
+
+bool MainWindow::restoreViewpoint(const QString& name) {
+    const QVariantList values =
+        QSettings().value(viewpointKey(m_viewpointFile)).toMap().value(name).toList();
+    if (values.size() != 7) {
+        return false;
+    }
+    ViewCamera camera = m_view->camera();
+    camera.setPose(glm::dvec3(values[0].toDouble(), values[1].toDouble(), values[2].toDouble()),
+                   values[3].toDouble(), values[4].toDouble(), values[5].toDouble());
+    camera.setOrthographic(values[6].toBool());
+    m_view->setCamera(camera);
+    if (auto* orthographic = findChild<QAction*>(QStringLiteral("actionOrthographic"))) {
+        orthographic->setChecked(camera.orthographic());
+    }
+    return true;
+}
+
+void MainWindow::deleteViewpoint(const QString& name) {
+    QSettings settings;
+    QVariantMap all = settings.value(viewpointKey(m_viewpointFile)).toMap();
+    all.remove(name);
+    settings.setValue(viewpointKey(m_viewpointFile), all);
+    updateViewpointMenu();
+}
+
+void MainWindow::updateViewpointMenu() {
+    if (m_viewpointMenu == nullptr) {
+        return;
+    }
+    m_viewpointMenu->clear();
+    QAction* save = m_viewpointMenu->addAction(tr("&Save Viewpoint…"));
+    save->setShortcut(QKeySequence(tr("Ctrl+Shift+V")));
+    connect(save, &QAction::triggered, this, [this] {
+        bool ok = false;
+        const QString name = QInputDialog::getText(
+            this, tr("Save Viewpoint"),
+            tr("Name of this viewpoint (kept with %1):")
+                .arg(m_viewpointFile.isEmpty() ? tr("the generated scene")
+                                               : QFileInfo(m_viewpointFile).fileName()),
+            QLineEdit::Normal, QString(), &ok);
+        if (ok) {
+            saveViewpoint(name);
+        }
+    });
+    const QStringList names = viewpointNames();
+    if (!names.isEmpty()) {
+        m_viewpointMenu->addSeparator();
+    }
+    QMenu* remove = names.isEmpty() ? nullptr : new QMenu(tr("&Delete"), m_viewpointMenu);
+    for (const QString& name : names) {
+        connect(m_viewpointMenu->addAction(name), &QAction::triggered, this,
+                [this, name] { restoreViewpoint(name); });
+        connect(remove->addAction(name), &QAction::triggered, this,
+                [this, name] { deleteViewpoint(name); });
+    }
+    if (remove != nullptr) {
+        m_viewpointMenu->addSeparator();
+        m_viewpointMenu->addMenu(remove);
+    }
+}
+
 void MainWindow::openDefaultScene(quint64 points) {
+    m_viewpointFile.clear();
+    updateViewpointMenu();
     m_service->setOptions(m_buildPanel->pipelineOptions());
     m_service->openGeneratedScene(points, kDefaultSceneSeed);
 }
@@ -515,8 +642,12 @@ void MainWindow::exportPotree(const QString& folder) {
     }
 }
 
-bool MainWindow::saveScreenshot(const QString& path) {
-    const QImage image = m_view->renderImage(m_view->size() * m_view->devicePixelRatio());
+bool MainWindow::saveScreenshot(const QString& path, QSize size) {
+    if (size.isEmpty()) {
+        size = m_view->size() * m_view->devicePixelRatio();
+    }
+    // Drawn again at that size (the front refined for it), not scaled from the screen.
+    const QImage image = m_view->renderImage(size);
     return !image.isNull() && image.save(path);
 }
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 class QLabel;
+class QMenu;
 class QMessageBox;
 class QProgressBar;
 
@@ -60,6 +61,13 @@ public:
     // for all level columns, the charts a third of the height.
     void applyDefaultDockSizes(QSize window);
 
+    // Named viewpoints (camera pose and projection) kept with the open file's path in the
+    // settings (View → Viewpoints).
+    QStringList viewpointNames() const;
+    void saveViewpoint(const QString& name);
+    bool restoreViewpoint(const QString& name);
+    void deleteViewpoint(const QString& name);
+
 public slots:
     // What File -> Open does after its dialog: pipeline 1 (PLY/LAS/LAZ/XYZ), 2 (.oms) or 3 (.omh).
     void openFile(const QString& path);
@@ -70,7 +78,8 @@ public slots:
     // File -> Export Potree…: the hierarchy as a Potree 2.0 folder, on the service's worker,
     // with the status bar's progress bar; Cancel stops it and leaves no folder.
     void exportPotree(const QString& folder);
-    bool saveScreenshot(const QString& path);
+    // At `size` (empty: the view's own), rendered at that resolution.
+    bool saveScreenshot(const QString& path, QSize size = {});
     void showError(const QString& path, const QString& message);
 
 protected:
@@ -85,6 +94,7 @@ private:
     void connectService();
     void loadSettings();
     void createMeasureTools();
+    void updateViewpointMenu();
     void saveSettings() const;
     void addRecentFile(const QString& path);
     void updateRecentMenu();
@@ -107,6 +117,8 @@ private:
     ClipPanel* m_clipPanel = nullptr;
     QStringList m_recentFiles;
     QString m_title; // what is shown: file name or "generated scene"
+    QString m_viewpointFile; // whose viewpoints the menu lists (absolute path; empty: a scene)
+    QMenu* m_viewpointMenu = nullptr;
     PipelineProgress m_progress;
     QLabel* m_phaseLabel = nullptr;
     QLabel* m_pointsLabel = nullptr;

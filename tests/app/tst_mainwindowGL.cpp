@@ -154,16 +154,18 @@ void TestMainWindowGL::openingASharedFileBuildsAndFillsThePanels() {
         QVERIFY(distance != nullptr);
         distance->trigger();
         QCOMPARE(view->measureTool(), std::optional<MeasureKind>(MeasureKind::Distance));
-        QPoint second(-1, -1);
-        for (int y = view->height() - 1; y >= 0 && second.x() < 0; y -= 8) {
-            for (int x = view->width() - 1; x >= 0 && second.x() < 0; x -= 8) {
+        // Two points the current frame draws (the front refines between frames: look now).
+        std::vector<QPoint> drawn;
+        for (int y = 0; y < view->height(); y += 8) {
+            for (int x = 0; x < view->width(); x += 8) {
                 if (view->pickCloudPoint(QPoint(x, y))) {
-                    second = QPoint(x, y);
+                    drawn.emplace_back(x, y);
                 }
             }
         }
-        QVERIFY(view->addMeasurePoint(onCloud));
-        QVERIFY(view->addMeasurePoint(second));
+        QVERIFY(drawn.size() >= 2);
+        QVERIFY(view->addMeasurePoint(drawn.front()));
+        QVERIFY(view->addMeasurePoint(drawn.back()));
         QCOMPARE(view->measurements().size(), std::size_t{1});
         QTableWidget* measured = window.measurementsPanel()->table();
         QCOMPARE(measured->rowCount(), 1);
@@ -219,6 +221,24 @@ void TestMainWindowGL::openingASharedFileBuildsAndFillsThePanels() {
         const QString shot = dir.filePath(QStringLiteral("shot.png"));
         QVERIFY(window.saveScreenshot(shot));
         QVERIFY(!QImage(shot).isNull());
+        // At a chosen resolution larger than the window: drawn at that size.
+        const QString large = dir.filePath(QStringLiteral("large.png"));
+        QVERIFY(window.saveScreenshot(large, QSize(1600, 1200)));
+        QCOMPARE(QImage(large).size(), QSize(1600, 1200));
+
+        // A named viewpoint: saved, the camera moved away, restored exactly.
+        window.cloudView()->setStandardView(StandardView::Front);
+        const ViewCamera front = window.cloudView()->camera();
+        window.saveViewpoint(QStringLiteral("front of the bunny"));
+        QCOMPARE(window.viewpointNames(), QStringList{QStringLiteral("front of the bunny")});
+        window.cloudView()->setStandardView(StandardView::Top);
+        QVERIFY(window.cloudView()->camera().pitchRadians() != front.pitchRadians());
+        QVERIFY(window.restoreViewpoint(QStringLiteral("front of the bunny")));
+        QCOMPARE(window.cloudView()->camera().pivot(), front.pivot());
+        QCOMPARE(window.cloudView()->camera().distance(), front.distance());
+        QCOMPARE(window.cloudView()->camera().yawRadians(), front.yawRadians());
+        QCOMPARE(window.cloudView()->camera().pitchRadians(), front.pitchRadians());
+        QVERIFY(!window.restoreViewpoint(QStringLiteral("no such viewpoint")));
         window.close();
     }
     // Recent files and parameters persisted; a new window starts with them.
@@ -227,6 +247,14 @@ void TestMainWindowGL::openingASharedFileBuildsAndFillsThePanels() {
     QCOMPARE(again.buildPanel()->pipelineOptions().build.maxLevel, 9);
     QCOMPARE(again.buildPanel()->pipelineOptions().storage, PointStorage::Packed);
     QCOMPARE(again.chartsPanel()->followSeconds(), 30.0);
+    // Viewpoints are kept with the file: listed again when it is opened again.
+    QVERIFY(again.viewpointNames().isEmpty()); // no file open yet
+    again.openFile(path);
+    QCOMPARE(again.viewpointNames(), QStringList{QStringLiteral("front of the bunny")});
+    again.deleteViewpoint(QStringLiteral("front of the bunny"));
+    QVERIFY(again.viewpointNames().isEmpty());
+    QSignalSpy done(again.service(), &BuilderService::buildFinished);
+    QTRY_VERIFY_WITH_TIMEOUT(done.count() == 1, kBuildTimeoutMs);
 }
 
 void TestMainWindowGL::malformedFileShowsANamedErrorAndTheAppStaysUsable() {
