@@ -199,16 +199,17 @@ public:
             if (from && to && *from != *to) {
                 QPointF direction = *to - *from;
                 direction /= std::hypot(direction.x(), direction.y());
-                const QPointF centre(size.width() - 36.0, 40.0);
-                const QPointF tip = centre + direction * 20.0;
-                const QPointF tail = centre - direction * 20.0;
+                // Room around it for the arrow and its N whichever way north points.
+                const QPointF centre(size.width() - 42.0, 42.0);
+                const QPointF tip = centre + direction * 16.0;
+                const QPointF tail = centre - direction * 16.0;
                 const QPointF side(-direction.y() * 7.0, direction.x() * 7.0);
                 painter.setPen(QPen(QColor(235, 235, 235), 2.0));
                 painter.drawLine(tail, tip);
                 painter.setBrush(QColor(235, 235, 235));
                 painter.drawPolygon(QPolygonF({tip, tip - direction * 12.0 + side,
                                                tip - direction * 12.0 - side}));
-                painter.drawText(QRectF(tip + direction * 12.0 - QPointF(8, 8), QSizeF(16, 16)),
+                painter.drawText(QRectF(tip + direction * 10.0 - QPointF(8, 8), QSizeF(16, 16)),
                                  Qt::AlignCenter, QStringLiteral("N"));
             }
         }
