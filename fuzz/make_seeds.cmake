@@ -1,0 +1,12 @@
+# The .oms and .omh fuzz seeds: bunny.ply sorted and built (depth 4, so the seeds stay small).
+file(MAKE_DIRECTORY ${OUT})
+if(NOT EXISTS ${SOURCE})
+  message(STATUS "no ${SOURCE}: the .oms and .omh fuzz targets will skip")
+  return()
+endif()
+execute_process(COMMAND ${CLI} sort ${SOURCE} ${OUT}/bunny.oms RESULT_VARIABLE sorted)
+execute_process(COMMAND ${CLI} build ${SOURCE} --depth 4 --save ${OUT}/bunny.omh
+                RESULT_VARIABLE built OUTPUT_QUIET)
+if(NOT sorted EQUAL 0 OR NOT built EQUAL 0)
+  message(FATAL_ERROR "omicron-cli could not make the fuzz seeds (${sorted}, ${built})")
+endif()
