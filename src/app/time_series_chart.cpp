@@ -88,7 +88,7 @@ TimeSeriesChart::TimeSeriesChart(const QString& title, const QString& unit, Char
     setChart(chart);
     delete defaultChart;
     setRenderHint(QPainter::Antialiasing);
-    setMinimumSize(220, 160);
+    setMinimumSize(200, 120);
     setToolTip(tr("%1 (%2). Hover a line for exact values; right-click to export the chart as "
                   "PNG or its data as CSV.")
                    .arg(title, unit));

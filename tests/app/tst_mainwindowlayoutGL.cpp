@@ -114,6 +114,17 @@ void TestMainWindowLayoutGL::panelsReadAtAGlanceAfterABuild() {
 
     const QRegularExpression exponent(QStringLiteral("\\d[eE][+-]?\\d"));
     for (const TimeSeriesChart* chart : charts->charts()) {
+        // Whole in the dock: not scrolled out of its scroll area's viewport.
+        const QWidget* viewport = charts->parentWidget();
+        const QRect shown(chart->mapTo(viewport, QPoint(0, 0)), chart->size());
+        QVERIFY2(viewport->rect().contains(shown),
+                 qPrintable(chart->title() + QStringLiteral(" at %1,%2 %3x%4 in a %5x%6 dock")
+                                                 .arg(shown.x())
+                                                 .arg(shown.y())
+                                                 .arg(shown.width())
+                                                 .arg(shown.height())
+                                                 .arg(viewport->width())
+                                                 .arg(viewport->height())));
         QCOMPARE(chart->timeFrom(), charts->charts().front()->timeFrom());
         QCOMPARE(chart->timeTo(), charts->charts().front()->timeTo());
         for (const QString& label : chart->axisLabels()) {

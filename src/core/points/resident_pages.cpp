@@ -43,7 +43,8 @@ std::size_t ResidentPages::release(std::size_t begin, std::size_t end) {
     std::size_t released = 0;
     std::lock_guard lock(m_mutex);
     for (Array& array : m_arrays) {
-        const auto [first, last] = pagesOf(array, begin, end);
+        const auto pages = pagesOf(array, begin, end);
+        const std::size_t first = pages.first, last = pages.second; // (a lambda captures them)
         // Consecutive free pages go back in one call.
         std::size_t runStart = last;
         const auto flush = [&](std::size_t runEnd) {
