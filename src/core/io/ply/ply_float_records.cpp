@@ -155,8 +155,11 @@ std::size_t convertScalar(const std::uint8_t* records, std::size_t count,
                                 static_cast<double>(y) + offset.y,
                                 static_cast<double>(z) + offset.z);
         positions[r] = glm::vec3((source - origin) * inverseEdge);
-        copyOptionalAttributes<kNormals, kColors>(record, normalAt, colorAt, normals + r,
-                                                  colors + r);
+        // No arithmetic on an absent array's null pointer (undefined behaviour; found by
+        // fuzz_ply under UBSan).
+        copyOptionalAttributes<kNormals, kColors>(record, normalAt, colorAt,
+                                                  kNormals ? normals + r : nullptr,
+                                                  kColors ? colors + r : nullptr);
     }
     return count;
 }
@@ -245,8 +248,11 @@ std::size_t convertSse2(const std::uint8_t* records, std::size_t count,
         float* position = &positions[r].x;
         _mm_storel_pi(reinterpret_cast<__m64*>(position), unit);
         _mm_store_ss(position + 2, _mm_movehl_ps(unit, unit));
-        copyOptionalAttributes<kNormals, kColors>(record, normalAt, colorAt, normals + r,
-                                                  colors + r);
+        // No arithmetic on an absent array's null pointer (undefined behaviour; found by
+        // fuzz_ply under UBSan).
+        copyOptionalAttributes<kNormals, kColors>(record, normalAt, colorAt,
+                                                  kNormals ? normals + r : nullptr,
+                                                  kColors ? colors + r : nullptr);
     }
     return count;
 }
