@@ -1,23 +1,9 @@
 #include "edl_pass.hpp"
 
+#include "gl_texture.hpp"
 #include "shader_library.hpp"
 
 namespace omicron {
-
-namespace {
-
-void makeTexture(QOpenGLExtraFunctions& gl, unsigned& texture, GLint internalFormat, GLenum format,
-                 GLenum type, int widthPx, int heightPx) {
-    gl.glGenTextures(1, &texture);
-    gl.glBindTexture(GL_TEXTURE_2D, texture);
-    gl.glTexImage2D(GL_TEXTURE_2D, 0, internalFormat, widthPx, heightPx, 0, format, type, nullptr);
-    gl.glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl.glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl.glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    gl.glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-}
-
-} // namespace
 
 void EdlPass::initializeGL() {
     m_program = buildShaderProgram({"fullscreen.vert", "edl.frag"});
@@ -48,8 +34,8 @@ bool EdlPass::begin(QOpenGLExtraFunctions& gl, int widthPx, int heightPx,
         }
         m_widthPx = widthPx;
         m_heightPx = heightPx;
-        makeTexture(gl, m_color, GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, widthPx, heightPx);
-        makeTexture(gl, m_depth, GL_DEPTH_COMPONENT24, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT,
+        makeTargetTexture(gl, m_color, GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, widthPx, heightPx);
+        makeTargetTexture(gl, m_depth, GL_DEPTH_COMPONENT24, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT,
                     widthPx, heightPx);
         gl.glBindTexture(GL_TEXTURE_2D, 0);
         gl.glGenFramebuffers(1, &m_framebuffer);

@@ -1,21 +1,8 @@
 #include "splat_target.hpp"
 
+#include "gl_texture.hpp"
+
 namespace omicron {
-
-namespace {
-
-void makeTexture(QOpenGLExtraFunctions& gl, unsigned& texture, GLint internalFormat, GLenum format,
-                 GLenum type, int widthPx, int heightPx) {
-    gl.glGenTextures(1, &texture);
-    gl.glBindTexture(GL_TEXTURE_2D, texture);
-    gl.glTexImage2D(GL_TEXTURE_2D, 0, internalFormat, widthPx, heightPx, 0, format, type, nullptr);
-    gl.glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl.glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl.glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    gl.glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-}
-
-} // namespace
 
 bool SplatTarget::ensureSize(QOpenGLExtraFunctions& gl, int widthPx, int heightPx) {
     if (m_framebuffer != 0 && widthPx == m_widthPx && heightPx == m_heightPx) {
@@ -24,8 +11,8 @@ bool SplatTarget::ensureSize(QOpenGLExtraFunctions& gl, int widthPx, int heightP
     release(gl);
     m_widthPx = widthPx;
     m_heightPx = heightPx;
-    makeTexture(gl, m_accumulation, GL_RGBA16F, GL_RGBA, GL_FLOAT, widthPx, heightPx);
-    makeTexture(gl, m_depth, GL_DEPTH_COMPONENT24, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, widthPx,
+    makeTargetTexture(gl, m_accumulation, GL_RGBA16F, GL_RGBA, GL_FLOAT, widthPx, heightPx);
+    makeTargetTexture(gl, m_depth, GL_DEPTH_COMPONENT24, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, widthPx,
                 heightPx);
     gl.glBindTexture(GL_TEXTURE_2D, 0);
     gl.glGenFramebuffers(1, &m_framebuffer);

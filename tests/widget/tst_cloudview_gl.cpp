@@ -49,6 +49,24 @@ void writeGrid(const QString& path, double zPerColumn) {
     }
 }
 
+// The grid built (its file is gone once the points are in memory).
+std::shared_ptr<const Hierarchy> gridHierarchy(double zPerColumn) {
+    QTemporaryDir dir;
+    const QString path = dir.filePath(QStringLiteral("grid.ply"));
+    writeGrid(path, zPerColumn);
+    return test::buildHierarchy(path, BuildOptions{});
+}
+
+// `view` shown at 400 x 400 from above, drawing `hierarchy` with plain settings.
+void showFromAbove(CloudView& view, std::shared_ptr<const Hierarchy> hierarchy) {
+    view.setRenderSettings(plainSettings());
+    view.setHierarchy(std::move(hierarchy));
+    view.setStandardView(StandardView::Top);
+    view.resize(400, 400);
+    view.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&view));
+}
+
 // Where the view draws the source point `p` of `hierarchy` (widget coordinates).
 QPoint pixelOf(const CloudView& view, const Hierarchy& hierarchy, const glm::dvec3& p) {
     const glm::dvec3 unit(hierarchy.cloud().cube().toUnit(p));
@@ -198,17 +216,10 @@ private slots:
     // coloured points 1 m apart with a georeferenced offset, seen from above; over empty
     // space, nothing. Hovering emits the same point.
     void aPickAtAKnownPixelReturnsTheKnownPoint() {
-        QTemporaryDir dir;
-        const QString path = dir.filePath(QStringLiteral("grid.ply"));
-        writeGrid(path, 0.0);
-        const auto hierarchy = test::buildHierarchy(path, BuildOptions{});
+        const auto hierarchy = gridHierarchy(0.0);
         CloudView view;
-        view.setRenderSettings(plainSettings());
-        view.setHierarchy(hierarchy);
-        view.setStandardView(StandardView::Top);
-        view.resize(400, 400);
-        view.show();
-        QVERIFY(QTest::qWaitForWindowExposed(&view));
+        showFromAbove(view, hierarchy);
+        QVERIFY(!QTest::currentTestFailed());
         QTRY_VERIFY(view.lastFrameStats().pointsDrawn == 400);
         for (const auto& [i, j] : {std::pair{7, 11}, std::pair{0, 0}, std::pair{19, 3}}) {
             const auto picked = view.pickCloudPoint(
@@ -240,17 +251,10 @@ private slots:
     // The measure tool: clicks on drawn points of the grid (z rising by 0.5 per column) give
     // the distance, height difference, polyline length and horizontal area of those points.
     void measurementsBetweenPickedPointsAreTheirGeometry() {
-        QTemporaryDir dir;
-        const QString path = dir.filePath(QStringLiteral("grid.ply"));
-        writeGrid(path, 0.5);
-        const auto hierarchy = test::buildHierarchy(path, BuildOptions{});
+        const auto hierarchy = gridHierarchy(0.5);
         CloudView view;
-        view.setRenderSettings(plainSettings());
-        view.setHierarchy(hierarchy);
-        view.setStandardView(StandardView::Top);
-        view.resize(400, 400);
-        view.show();
-        QVERIFY(QTest::qWaitForWindowExposed(&view));
+        showFromAbove(view, hierarchy);
+        QVERIFY(!QTest::currentTestFailed());
         QTRY_VERIFY(view.lastFrameStats().pointsDrawn == 400);
         const auto grid = [](int i, int j) {
             return glm::dvec3(500000.0 + i, 4000000.0 + j, 100.0 + 0.5 * i);
