@@ -724,13 +724,13 @@ void MainWindow::loadSettings() {
 
 void MainWindow::applyDefaultDockSizes(QSize window) {
     // The cut panel wide enough for every column of its level table (never more than 45 % of
-    // the window), the charts two fifths of the height (both rows of charts whole, under
-    // their tab bar): the view keeps the rest.
+    // the window), the charts 45 % of the height (both rows of charts whole, with room for
+    // their tick labels, under their tab bar): the view keeps the rest.
     const int cutWidth =
         std::min(m_cutPanel->widthForAllLevelColumns(), window.width() * 45 / 100);
     resizeDocks({findChild<QDockWidget*>(QStringLiteral("cutDock"))}, {cutWidth}, Qt::Horizontal);
     resizeDocks({findChild<QDockWidget*>(QStringLiteral("chartsDock"))},
-                {window.height() * 2 / 5}, Qt::Vertical);
+                {window.height() * 9 / 20}, Qt::Vertical);
 }
 
 void MainWindow::saveSettings() const {

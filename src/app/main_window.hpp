@@ -58,7 +58,7 @@ public:
     // The error dialog currently shown (nullptr when none).
     QMessageBox* errorDialog() const;
     // The first start's dock layout for a window of `window`'s size: the cut panel wide enough
-    // for all level columns, the charts two fifths of the height.
+    // for all level columns, the charts 45 % of the height.
     void applyDefaultDockSizes(QSize window);
 
     // Named viewpoints (camera pose and projection) kept with the open file's path in the

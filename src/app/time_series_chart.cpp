@@ -15,6 +15,7 @@
 #include <QToolTip>
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace omicron {
 
@@ -22,8 +23,28 @@ namespace {
 
 // Labels an axis with round ticks over [from, to]: a category axis whose categories end on
 // the ticks, labelled on their values (a plain value axis can only printf its labels).
-void setTicks(QCategoryAxis* axis, double from, double to, int targetCount, ChartUnit unit) {
-    const AxisTicks ticks = roundTicks(from, to, targetCount, unit);
+// Qt Charts gives each label of a category axis an equal share of the axis (its length over
+// the number of category bounds, less padding) and cuts longer ones to "...": no more ticks
+// than the axis has room for (`maxCount`), fewer than the target if need be.
+void setTicks(QCategoryAxis* axis, double from, double to, int targetCount, int maxCount,
+              ChartUnit unit) {
+    AxisTicks ticks = roundTicks(from, to, targetCount, unit);
+    for (int target = targetCount - 1;
+         static_cast<int>(ticks.values.size()) > maxCount && target >= 2; --target) {
+        ticks = roundTicks(from, to, target, unit);
+    }
+    if (static_cast<int>(ticks.values.size()) > maxCount) {
+        // Still too many: every k-th tick (multiples of a round step stay round enough).
+        const std::size_t keepEvery =
+            (ticks.values.size() + static_cast<std::size_t>(maxCount) - 1) /
+            static_cast<std::size_t>(std::max(1, maxCount));
+        std::vector<double> kept;
+        for (std::size_t i = 0; i < ticks.values.size(); i += keepEvery) {
+            kept.push_back(ticks.values[i]);
+        }
+        ticks.values = std::move(kept);
+        ticks.step *= static_cast<double>(keepEvery);
+    }
     const QStringList labels = tickLabels(ticks);
     for (const QString& label : axis->categoriesLabels()) {
         axis->remove(label);
@@ -55,6 +76,11 @@ TimeSeriesChart::TimeSeriesChart(const QString& title, const QString& unit, Char
     : QChartView(parent), m_title(title), m_unit(unit), m_scale(scale) {
     auto* chart = new QChart();
     chart->setMargins(QMargins(2, 2, 2, 2));
+    // With a fixed plot area (placePlotArea) Qt Charts lays the axes out again only when the
+    // plot background is visible: a transparent one, so new tick labels get their room.
+    chart->setPlotAreaBackgroundVisible(true);
+    chart->setPlotAreaBackgroundBrush(Qt::NoBrush);
+    chart->setPlotAreaBackgroundPen(Qt::NoPen);
     chart->setTitle(title);
     // Small panels: short labels in a small font; the units are in the tick labels.
     QFont smallFont = chart->font();
@@ -88,7 +114,7 @@ TimeSeriesChart::TimeSeriesChart(const QString& title, const QString& unit, Char
     setChart(chart);
     delete defaultChart;
     setRenderHint(QPainter::Antialiasing);
-    setMinimumSize(200, 120);
+    setMinimumSize(200, 140);
     setToolTip(tr("%1 (%2). Hover a line for exact values; right-click to export the chart as "
                   "PNG or its data as CSV.")
                    .arg(title, unit));
@@ -156,8 +182,19 @@ void TimeSeriesChart::updateTicks() {
     const int timeTicks = std::clamp(static_cast<int>(area.width()) / kPixelsPerTimeTick, 2, 8);
     const int valueTicks =
         std::clamp(static_cast<int>(area.height()) / kPixelsPerValueTick, 2, 5);
-    setTicks(m_axisX, m_timeFrom, m_timeTo, timeTicks, ChartUnit::Seconds);
-    setTicks(m_axisY, 0.0, m_maxValue, valueTicks, m_scale);
+    // Room for whole labels: Qt gives each label the axis length over 1 + ticks, less twice
+    // its label padding (5 px); a value label needs its text's height, a time label the
+    // width of the widest one ("000.0 s").
+    constexpr int kLabelPadding = 5;
+    const QFontMetrics metrics(m_axisY->labelsFont());
+    const int valueRoom =
+        static_cast<int>(area.height()) / (metrics.height() + 2 * kLabelPadding) - 1;
+    const int timeRoom =
+        static_cast<int>(area.width()) /
+            (metrics.horizontalAdvance(QStringLiteral("000.0 s")) + 2 * kLabelPadding) -
+        1;
+    setTicks(m_axisX, m_timeFrom, m_timeTo, timeTicks, std::max(1, timeRoom), ChartUnit::Seconds);
+    setTicks(m_axisY, 0.0, m_maxValue, valueTicks, std::max(1, valueRoom), m_scale);
 }
 
 void TimeSeriesChart::placePlotArea() {

@@ -135,7 +135,10 @@ void TestMainWindowLayoutGL::panelsReadAtAGlanceAfterABuild() {
         // laid out again when ticks change, in the event loop before the next paint).
         const auto firstUnreadable = [&]() -> QString {
             const QStringList texts = drawnTexts(*chart);
-            const QString all = chart->title() + QStringLiteral(": ") +
+            const QString all = chart->title() + QStringLiteral(" (plot %1x%2, labels %3): ")
+                                                     .arg(chart->chart()->plotArea().width())
+                                                     .arg(chart->chart()->plotArea().height())
+                                                     .arg(chart->axisLabels().join(QStringLiteral(","))) +
                                 texts.join(QStringLiteral(" | "));
             if (!texts.contains(chart->title())) {
                 return QStringLiteral("no title in ") + all;
