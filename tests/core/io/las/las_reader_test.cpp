@@ -205,8 +205,12 @@ TEST(LasAutzenTest, KnownBoundsReplaceTheHeaderBounds) {
     expectInUnitCube(back.points.positions);
 }
 
-TEST(LasAutzenTest, CancelStopsBetweenBatches) {
-    OMICRON_REQUIRE_SHARED_FILE(path, "autzen_trim.las");
+// The same cancel between batches for the LAS file and its LAZ twin (chunks decoded in
+// parallel, delivered in batches all the same).
+class LasAndLazCancel : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(LasAndLazCancel, CancelStopsBetweenBatches) {
+    OMICRON_REQUIRE_SHARED_FILE(path, GetParam());
     auto reader = openLasReader(path, {});
     std::atomic<bool> cancel{false};
     ReadOptions options;
@@ -225,6 +229,9 @@ TEST(LasAutzenTest, CancelStopsBetweenBatches) {
     EXPECT_EQ(summary.batches, 2u);
     EXPECT_EQ(summary.pointsDelivered, 20000u);
 }
+
+INSTANTIATE_TEST_SUITE_P(Autzen, LasAndLazCancel,
+                         ::testing::Values("autzen_trim.las", "laz/autzen_trim.laz"));
 
 TEST(LasAutzenTest, CompressionBitWithoutLaszipRecordIsMalformed) {
     OMICRON_REQUIRE_SHARED_FILE(source, "autzen_trim.las");

@@ -64,26 +64,5 @@ TEST(LazReader, BatchesHoldAtMostBatchPointsAndEveryPointArrives) {
     EXPECT_EQ(summary.batches, (110000u + 6999u) / 7000u);
 }
 
-TEST(LazReader, CancelStopsBetweenBatches) {
-    OMICRON_REQUIRE_SHARED_FILE(path, "laz/autzen_trim.laz");
-    auto reader = openPointCloud(path);
-    std::atomic<bool> cancel{false};
-    ReadOptions options;
-    options.batchPoints = 10000;
-    options.cancel = &cancel;
-    std::size_t seen = 0;
-    const ReadSummary summary = reader->read(
-        [&](const PointBatch& batch) {
-            seen += batch.size();
-            if (seen >= 20000) {
-                cancel = true;
-            }
-        },
-        options);
-    EXPECT_TRUE(summary.cancelled);
-    EXPECT_EQ(summary.batches, 2u);
-    EXPECT_EQ(summary.pointsDelivered, 20000u);
-}
-
 } // namespace
 } // namespace omicron
