@@ -141,11 +141,10 @@ void TimeSeriesChart::clear() {
     for (QLineSeries* series : m_lines) {
         series->clear();
     }
-    m_maxSeconds = 1.0;
     m_maxValue = 1.0;
     if (!m_sharedTime) {
         m_timeFrom = 0.0;
-        m_timeTo = m_maxSeconds;
+        m_timeTo = 1.0;
     }
     updateTicks();
 }
@@ -215,9 +214,8 @@ void TimeSeriesChart::growAxes(double seconds, double value) {
     // Axes only grow, to a round value with room to spare, so a live chart does not jitter
     // every sample and its last tick is labelled.
     bool grown = false;
-    if (!m_sharedTime && seconds > m_maxSeconds) {
-        m_maxSeconds = roundAxisEnd(seconds * 1.2, kGrowthTicks, ChartUnit::Seconds);
-        m_timeTo = m_maxSeconds;
+    if (!m_sharedTime && seconds > m_timeTo) {
+        m_timeTo = roundAxisEnd(seconds * 1.2, kGrowthTicks, ChartUnit::Seconds);
         grown = true;
     }
     if (value > m_maxValue) {

@@ -72,9 +72,9 @@ private:
     QCategoryAxis* m_axisX = nullptr;
     QCategoryAxis* m_axisY = nullptr;
     bool m_sharedTime = false; // setTimeRange() decides the time axis
-    double m_maxSeconds = 1.0; // the time axis grown by the samples (no shared range)
     double m_maxValue = 1.0;
-    double m_timeFrom = 0.0; // the time axis shown
+    // The time axis shown: set by setTimeRange, or grown by the samples until it is called.
+    double m_timeFrom = 0.0;
     double m_timeTo = 1.0;
 };
 

@@ -171,12 +171,11 @@ public:
             label(*draft);
         }
         if (settings.showScaleBar) {
-            // File units per pixel at the pivot (anywhere, in an orthographic view).
-            const double unitsPerPixel =
-                (camera.orthographic() ? 1.0 : camera.distance()) /
-                (camera.orthographic() ? camera.screenScale(heightPx)
-                                       : camera.pixelsPerUnitAtUnitDistance(heightPx)) *
-                cube.edge * (heightPx / size.height());
+            // File units per pixel at the pivot (anywhere, in an orthographic view, which is
+            // as high as the perspective one at the pivot).
+            const double unitsPerPixel = camera.distance() /
+                                         camera.pixelsPerUnitAtUnitDistance(heightPx) *
+                                         cube.edge * (heightPx / size.height());
             const ScaleBar bar = scaleBarFor(unitsPerPixel, size.width() / 6.0);
             if (bar.widthPx > 0.0) {
                 const QPointF right(size.width() - 16.0, size.height() - 16.0);

@@ -34,11 +34,12 @@ std::optional<DrawnPoint> nearestDrawnPoint(const Hierarchy& hierarchy,
         const OctreeNode& node = hierarchy.node(entry.level(), entry.index);
         for (std::uint32_t i = 0; i < node.pointCount; ++i) {
             const std::uint32_t index = node.heldPoint(i);
-            const glm::dvec3 offset = glm::dvec3(cloud.position(index)) - unitPosition;
+            const glm::vec3 position = cloud.position(index);
+            const glm::dvec3 offset = glm::dvec3(position) - unitPosition;
             const double squared = offset.x * offset.x + offset.y * offset.y + offset.z * offset.z;
             if (squared <= bestSquared) {
                 bestSquared = squared;
-                best = DrawnPoint{index, entry.code, cloud.position(index), std::sqrt(squared)};
+                best = DrawnPoint{index, entry.code, position, std::sqrt(squared)};
             }
         }
     }

@@ -28,26 +28,37 @@ std::string lowerExtension(const std::string& path) {
 
 namespace {
 
-// The points of `all` inside `box` (unit cube), attributes kept alongside.
-PointBatch insideBox(const PointBatch& all, const ClipBox& box) {
-    PointBatch kept;
-    kept.attributes = all.attributes;
-    for (std::size_t i = 0; i < all.size(); ++i) {
-        if (!box.contains(glm::dvec3(all.positions[i]))) {
+// Keeps the points of `points` inside `box` (unit cube), attributes alongside, in place: the
+// export holds the cloud's copy once, not a second filtered one.
+void keepInsideBox(PointBatch& points, const ClipBox& box) {
+    const AttributeSet attributes = points.attributes;
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        if (!box.contains(glm::dvec3(points.positions[i]))) {
             continue;
         }
-        kept.positions.push_back(all.positions[i]);
-        if (all.attributes.has(Attribute::Normal)) {
-            kept.normals.push_back(all.normals[i]);
+        points.positions[kept] = points.positions[i];
+        if (attributes.has(Attribute::Normal)) {
+            points.normals[kept] = points.normals[i];
         }
-        if (all.attributes.has(Attribute::Color)) {
-            kept.colors.push_back(all.colors[i]);
+        if (attributes.has(Attribute::Color)) {
+            points.colors[kept] = points.colors[i];
         }
-        if (all.attributes.has(Attribute::Intensity)) {
-            kept.intensities.push_back(all.intensities[i]);
+        if (attributes.has(Attribute::Intensity)) {
+            points.intensities[kept] = points.intensities[i];
         }
+        ++kept;
     }
-    return kept;
+    points.positions.resize(kept);
+    if (attributes.has(Attribute::Normal)) {
+        points.normals.resize(kept);
+    }
+    if (attributes.has(Attribute::Color)) {
+        points.colors.resize(kept);
+    }
+    if (attributes.has(Attribute::Intensity)) {
+        points.intensities.resize(kept);
+    }
 }
 
 } // namespace
@@ -64,7 +75,7 @@ std::uint64_t exportCloudPoints(const std::string& path, const SortedCloud& clou
     PointBatch points;
     cloud.copyRange(0, cloud.sortedEnd(), points);
     if (clip) {
-        points = insideBox(points, toUnitCube(*clip, cloud.cube()));
+        keepInsideBox(points, toUnitCube(*clip, cloud.cube()));
         if (points.empty()) {
             throw OutputError(path + ": cannot export points: none lies inside the clip box");
         }
