@@ -3,6 +3,7 @@
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "formats/oms_reader.hpp"
+#include "io/cloud_export.hpp"
 #include "io/las/las_writer.hpp"
 #include "io/ply/ply_writer.hpp"
 #include "io/point_reader.hpp"
@@ -45,8 +46,12 @@ WholeCloud readWhole(const std::string& path) {
 
 // LAS stores integers: a millimetre step, or finer for a small cloud (at most 2^30 steps per
 // cube edge), against the cube's origin, so every coordinate fits in int32.
+// A cloud read from LAS or LAZ keeps every LAS field (LAS 1.4, see lasExportOptions).
 LasWriteOptions lasOptions(const WholeCloud& whole) {
     LasWriteOptions options;
+    if (whole.points.attributes.has(Attribute::Las)) {
+        options = lasExportOptions(whole.points.attributes, whole.cube);
+    }
     options.offset = whole.cube.origin;
     const double step = std::min(0.001, whole.cube.edge / double(1u << 30));
     options.scale = glm::dvec3(step);
@@ -105,7 +110,8 @@ const Command& convertCommand() {
         "convert IN OUT [--memory-budget SIZE] [--temp-dir DIR]",
         "Reads IN (PLY, LAS, LAZ, XYZ text or .oms) and writes OUT in the format its extension\n"
         "names: .ply (binary little-endian, float coordinates against a 'comment offset'),\n"
-        "LAS 1.2 point format 3 (.las, millimetre steps or finer), XYZ text (.xyz, .txt) or a\n"
+        "LAS (.las, millimetre steps or finer: LAS 1.4 format 6, 7 or 8 with every LAS field\n"
+        "and extra byte of a LAS or LAZ input, else LAS 1.2 format 3), XYZ text (.xyz, .txt) or a\n"
         "Morton-sorted stream (.oms, from a cloud that is not one already). Points keep\n"
         "their colour, normal and intensity where the output format has the field. OUT is\n"
         "replaced atomically.\n"

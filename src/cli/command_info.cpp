@@ -7,6 +7,7 @@
 #include "io/point_reader.hpp"
 #include "json_writer.hpp"
 #include "omh_info.hpp"
+#include "points/attribute_statistics.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -15,24 +16,11 @@ namespace omicron::cli {
 
 namespace {
 
-std::vector<std::string> attributeNames(AttributeSet attributes) {
-    std::vector<std::string> names;
-    if (attributes.has(Attribute::Normal)) {
-        names.emplace_back("normal");
-    }
-    if (attributes.has(Attribute::Color)) {
-        names.emplace_back("color");
-    }
-    if (attributes.has(Attribute::Intensity)) {
-        names.emplace_back("intensity");
-    }
-    return names;
-}
-
 struct InfoReport {
     std::string formatName; // "PLY binary little-endian", "OMS sorted stream", ...
     CloudInfo info;
     ReadSummary summary;
+    AttributeStatistics statistics;
     double openSeconds = 0.0; // header and bounds pre-pass
     double readSeconds = 0.0; // open and the full read
 };
@@ -56,6 +44,21 @@ void printJson(const InfoReport& report) {
         json.value(name);
     }
     json.endArray();
+    json.key("attribute_ranges").beginObject();
+    for (const NamedRange& range : report.statistics.ranges()) {
+        json.key(range.name).beginArray().value(range.range.min).value(range.range.max).endArray();
+    }
+    json.endObject();
+    if (info.attributes.has(Attribute::Las)) {
+        json.key("classes").beginObject();
+        const auto& counts = report.statistics.classCounts();
+        for (int c = 0; c < kLasClassCount; ++c) {
+            if (counts[static_cast<std::size_t>(c)] != 0) {
+                json.key(std::to_string(c)).value(counts[static_cast<std::size_t>(c)]);
+            }
+        }
+        json.endObject();
+    }
     json.key("bounds").beginObject();
     json.key("min");
     writeVector(json, info.sourceBounds.min);
@@ -90,6 +93,17 @@ void printText(const InfoReport& report) {
                 static_cast<unsigned long long>(report.summary.skippedNonFinite));
     std::printf("attributes:  %s\n",
                 attributes.empty() ? "none (positions only)" : attributes.c_str());
+    for (const NamedRange& range : report.statistics.ranges()) {
+        std::printf("  %-22s %.12g .. %.12g\n", range.name.c_str(), range.range.min,
+                    range.range.max);
+    }
+    const auto& counts = report.statistics.classCounts();
+    for (int c = 0; info.attributes.has(Attribute::Las) && c < kLasClassCount; ++c) {
+        if (counts[static_cast<std::size_t>(c)] != 0) {
+            std::printf("  class %3d %-24s %llu points\n", c, lasClassName(c).c_str(),
+                        static_cast<unsigned long long>(counts[static_cast<std::size_t>(c)]));
+        }
+    }
     std::printf("bounds min:  %.6f %.6f %.6f\n", b.min.x, b.min.y, b.min.z);
     std::printf("bounds max:  %.6f %.6f %.6f  (source units, %s)\n", b.max.x, b.max.y, b.max.z,
                 info.boundsFromHeader ? "from the header" : "from the points");
@@ -116,7 +130,7 @@ InfoReport readCloud(const std::string& path) {
     InfoReport report;
     report.formatName = toString(reader->info().format);
     report.info = reader->info();
-    report.summary = reader->read([](const PointBatch&) {});
+    report.summary = reader->read([&](const PointBatch& batch) { report.statistics.add(batch); });
     report.openSeconds = secondsBetween(start, opened);
     report.readSeconds = secondsBetween(start, Clock::now());
     return report;
@@ -140,10 +154,13 @@ InfoReport readSortedStream(const std::string& path) {
     report.info.sourceOffset = oms.sourceOffset;
     report.info.cube = oms.cube;
     Bounds bounds;
+    PointBatch batch;
     report.summary = reader.read([&](const SortedCloud& cloud, std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
             bounds.extend(cloud.cube().toSource(cloud.position(i)));
         }
+        cloud.copyRange(begin, end, batch);
+        report.statistics.add(batch);
     });
     report.info.sourceBounds = bounds;
     report.openSeconds = secondsBetween(start, opened);
@@ -188,10 +205,13 @@ const Command& infoCommand() {
         "checksums and Morton order are verified), streaming, and prints its format, the\n"
         "declared and read point counts, the attributes, the bounding box in source units,\n"
         "the source offset, the unit-cube transform, skipped non-finite points and the read\n"
-        "speed.\n"
+        "speed. Each attribute's range follows the list (colour per channel; LAS fields:\n"
+        "classification, returns, scan angle in degrees, user data, point source id, scanner\n"
+        "channel, flags, GPS time, NIR), then the points of each class present.\n"
         "\n"
         "  --json   print one JSON object instead (keys: path, format, format_detail,\n"
-        "           points_declared, points_read, skipped_non_finite, attributes, bounds,\n"
+        "           points_declared, points_read, skipped_non_finite, attributes,\n"
+        "           attribute_ranges {name: [min, max]}, classes {class: points}, bounds,\n"
         "           bounds_from_header, offset, cube, read_s)\n"
         "\n"
         "For a .omh hierarchy file it prints the build parameters, the attributes, the cube\n"

@@ -3,6 +3,7 @@
 #include "formats/omh_reader.hpp"
 #include "json_writer.hpp"
 #include "levels_json.hpp"
+#include "points/attribute_statistics.hpp"
 
 #include <cstdio>
 #include <string>
@@ -15,18 +16,6 @@ namespace {
 
 void writeVector(JsonWriter& json, const glm::dvec3& v) {
     json.beginArray().value(v.x).value(v.y).value(v.z).endArray();
-}
-
-std::vector<const char*> attributeNames(AttributeSet attributes) {
-    std::vector<const char*> names;
-    for (const auto& [attribute, name] : {std::pair{Attribute::Normal, "normal"},
-                                          std::pair{Attribute::Color, "color"},
-                                          std::pair{Attribute::Intensity, "intensity"}}) {
-        if (attributes.has(attribute)) {
-            names.push_back(name);
-        }
-    }
-    return names;
 }
 
 void printJson(const omh::Header& h, bool verified) {
@@ -43,7 +32,7 @@ void printJson(const omh::Header& h, bool verified) {
     json.key("dropped_points").value(h.build.droppedPoints);
     json.key("collapsed_leaves").value(h.build.collapsedLeaves);
     json.key("attributes").beginArray();
-    for (const char* name : attributeNames(h.attributes)) {
+    for (const std::string& name : attributeNames(h.attributes)) {
         json.value(name);
     }
     json.endArray();
@@ -66,7 +55,7 @@ void printJson(const omh::Header& h, bool verified) {
 
 void printText(const omh::Header& h, bool verified) {
     std::string attributes;
-    for (const char* name : attributeNames(h.attributes)) {
+    for (const std::string& name : attributeNames(h.attributes)) {
         attributes.append(attributes.empty() ? "" : ", ").append(name);
     }
     std::printf("file:        %s\n", h.path.c_str());

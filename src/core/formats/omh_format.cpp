@@ -46,6 +46,7 @@ std::array<std::uint8_t, kHeaderBytes> encodeHeader(const Header& h) {
     store(at + f::kLevelCount, static_cast<std::uint8_t>(h.levels.size()));
     store(at + f::kCollapse, encodeCollapse(h.build.collapse));
     store(at + f::kAttributes, h.attributes.bits());
+    store(at + f::kExtraBytes, h.attributes.extraBytes());
     store(at + f::kSplatBits, h.estimatedNormals ? kSplatEstimatedNormal : std::uint8_t{0});
     store(at + f::kRecordBytes, static_cast<std::uint16_t>(h.recordBytes));
     store(at + f::kRatio, h.build.ratio);

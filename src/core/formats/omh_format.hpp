@@ -66,7 +66,8 @@ inline constexpr std::size_t kRatio = 64;           // f64, (0, 1]
 inline constexpr std::size_t kCubeOrigin = 72;      // f64[3]
 inline constexpr std::size_t kCubeEdge = 96;        // f64, > 0
 inline constexpr std::size_t kSourceOffset = 104;   // f64[3]
-inline constexpr std::size_t kReserved1 = 128;      // 120 zero bytes
+inline constexpr std::size_t kExtraBytes = 128;     // u16, LAS extra bytes a point (Las only)
+inline constexpr std::size_t kReserved1 = 130;      // 118 zero bytes
 inline constexpr std::size_t kChecksum = 248;       // u64, XXH64 of bytes [0, 248)
 } // namespace header
 
@@ -97,7 +98,7 @@ inline constexpr std::size_t kTotalPoints = 16; // u64
 inline constexpr std::size_t kChecksum = 24;   // u64, XXH64 of footer bytes [0, 24)
 } // namespace footer
 
-// A point record: the .oms record (position, optional normal, colour, intensity), then the
+// A point record: the .oms record (position, optional normal, colour, intensity, LAS column), then the
 // splat radius (encodeRadius) and, when the splat bit says so, the octahedral estimated normal.
 struct RecordLayout {
     oms::RecordLayout point;

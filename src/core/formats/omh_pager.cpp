@@ -43,6 +43,8 @@ OmhPager::OmhPager(const omh::Header& header, std::shared_ptr<SortedCloud> cloud
     m_pages.addArray(c.mutableColors().data(), sizeof(glm::u8vec3), c.mutableColors().size());
     m_pages.addArray(c.mutableIntensities().data(), sizeof(std::uint16_t),
                      c.mutableIntensities().size());
+    m_pages.addArray(c.mutableLasColumn().data(), c.attributes().lasBytes(),
+                     c.mutableLasColumn().empty() ? 0 : n);
     StoredSplats& splats = hierarchy.mutableStoredSplats();
     m_pages.addArray(splats.mutableRadii().data(), sizeof(std::uint16_t), n);
     m_pages.addArray(splats.mutableNormals().data(), sizeof(std::uint32_t),

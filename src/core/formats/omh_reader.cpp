@@ -188,10 +188,10 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     if ((attributeBits & ~omh::kKnownAttributeBits) != 0) {
         throw malformed(h::kAttributes, "unknown attribute bits");
     }
-    for (Attribute a : {Attribute::Normal, Attribute::Color, Attribute::Intensity}) {
-        if ((attributeBits & static_cast<std::uint8_t>(a)) != 0) {
-            info.attributes.add(a);
-        }
+    info.attributes =
+        AttributeSet::fromBits(attributeBits, loadLe<std::uint16_t>(header.data() + h::kExtraBytes));
+    if (!info.attributes.valid()) {
+        throw malformed(h::kExtraBytes, "GPS time, NIR and extra bytes need the LAS attribute bit");
     }
     const std::uint8_t splatBits = header[h::kSplatBits];
     // The builder estimates normals exactly when the cloud has none of its own.

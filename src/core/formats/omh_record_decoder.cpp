@@ -48,6 +48,8 @@ std::size_t OmhRecordDecoder::store(const std::uint8_t* records, std::size_t cou
             m_cloud.mutableIntensities()[at] =
                 loadLe<std::uint16_t>(record + m_layout.point.intensityOffset);
         }
+        std::memcpy(m_cloud.mutableLasColumn().data() + at * m_layout.point.lasBytes,
+                    record + m_layout.point.lasOffset, m_layout.point.lasBytes);
         m_splats.setEncoded(at, loadLe<std::uint16_t>(record + m_layout.radiusOffset),
                             m_estimatedNormals
                                 ? loadLe<std::uint32_t>(record + m_layout.estimatedNormalOffset)

@@ -49,6 +49,8 @@ void OmhRecordSink::add(std::uint32_t index, std::uint16_t encodedRadius,
     if (attributes.has(Attribute::Intensity)) {
         store(record + m_layout.point.intensityOffset, m_cloud.intensities()[index]);
     }
+    std::memcpy(record + m_layout.point.lasOffset, m_cloud.lasRecord(index),
+                m_layout.point.lasBytes);
     store(record + m_layout.radiusOffset, encodedRadius);
     if (m_layout.estimatedNormalOffset != 0) {
         store(record + m_layout.estimatedNormalOffset, estimatedNormal);

@@ -3,10 +3,11 @@
 //
 // Layout (all little-endian; docs/FORMATS.md has the byte-by-byte table):
 //   header   128 bytes   magic "OMICRONS", version, endianness marker, point count, sort
-//                        depth, attribute bits, record size, cube (origin, edge), source
-//                        offset, reserved zeros, XXH64 of the 120 bytes before it
-//   records  count x R   float x y z (unit cube) [float nx ny nz] [u8 r g b] [u16 intensity],
-//                        packed, in non-decreasing Morton order
+//                        depth, attribute bits, record size, LAS extra bytes, cube (origin,
+//                        edge), source offset, reserved zeros, XXH64 of the 120 bytes before it
+//   records  count x R   float x y z (unit cube) [float nx ny nz] [u8 r g b] [u16 intensity]
+//                        [LAS column: points/las_fields.hpp], packed, in non-decreasing
+//                        Morton order
 //   footer   24 bytes    magic "OMSEND\0\0", point count again, XXH3-64 of all record bytes
 //
 // The Morton code is not stored: morton::encodeUnit on the stored float position gives the
@@ -37,7 +38,8 @@ inline constexpr std::uint32_t kVersion = 1;
 // Written as a native u32: bytes 04 03 02 01 on disk; a big-endian writer would put 01 02 03 04.
 inline constexpr std::uint32_t kEndiannessMarker = 0x01020304u;
 inline constexpr std::uint8_t kSortDepth = 21; // morton::kMaxLevel, the level codes are sorted at
-inline constexpr std::uint8_t kKnownAttributeBits = 0x07; // Normal | Color | Intensity
+// Normal | Color | Intensity | Las | GpsTime | Nir
+inline constexpr std::uint8_t kKnownAttributeBits = 0x3f;
 
 inline constexpr std::size_t kHeaderBytes = 128;
 inline constexpr std::size_t kFooterBytes = 24;
@@ -51,7 +53,8 @@ inline constexpr std::size_t kPointCount = 16;   // u64
 inline constexpr std::size_t kSortDepth = 24;    // u8
 inline constexpr std::size_t kAttributes = 25;   // u8, AttributeSet::bits()
 inline constexpr std::size_t kRecordBytes = 26;  // u16
-inline constexpr std::size_t kReserved0 = 28;    // u32, zero
+inline constexpr std::size_t kExtraBytes = 28;   // u16, LAS extra bytes a point (Las only)
+inline constexpr std::size_t kReserved0 = 30;    // u16, zero
 inline constexpr std::size_t kCubeOrigin = 32;   // f64[3], source units
 inline constexpr std::size_t kCubeEdge = 56;     // f64, > 0
 inline constexpr std::size_t kSourceOffset = 64; // f64[3]

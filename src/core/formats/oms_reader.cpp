@@ -145,13 +145,17 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage,
     if ((attributeBits & ~oms::kKnownAttributeBits) != 0) {
         throw error(InputErrorKind::UnsupportedFeature, h::kAttributes,
                     "expected attribute bits within " + hex(oms::kKnownAttributeBits, 2) +
-                        " (normal 1, colour 2, intensity 4), found " + hex(attributeBits, 2));
+                        " (normal 1, colour 2, intensity 4, LAS 8, GPS time 16, NIR 32), "
+                        "found " +
+                        hex(attributeBits, 2));
     }
-    AttributeSet attributes;
-    for (Attribute a : {Attribute::Normal, Attribute::Color, Attribute::Intensity}) {
-        if ((attributeBits & static_cast<std::uint8_t>(a)) != 0) {
-            attributes.add(a);
-        }
+    const auto extraBytes = load<std::uint16_t>(header.data() + h::kExtraBytes);
+    const AttributeSet attributes = AttributeSet::fromBits(attributeBits, extraBytes);
+    if (!attributes.valid()) {
+        throw error(InputErrorKind::MalformedHeader, h::kAttributes,
+                    "attribute bits " + hex(attributeBits, 2) + " with " +
+                        std::to_string(extraBytes) +
+                        " extra bytes: GPS time, NIR and extra bytes need the LAS bit (8)");
     }
     m_layout = oms::RecordLayout::of(attributes);
     const auto recordBytes = load<std::uint16_t>(header.data() + h::kRecordBytes);
@@ -325,6 +329,8 @@ ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptio
             if (attributes.has(Attribute::Intensity)) {
                 out.intensities[at] = load<std::uint16_t>(record + m_layout.intensityOffset);
             }
+            std::memcpy(out.las.data() + at * m_layout.lasBytes, record + m_layout.lasOffset,
+                        m_layout.lasBytes);
         }
         cloud.publish(end);
         consumer(cloud, begin, end);

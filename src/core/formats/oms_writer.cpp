@@ -34,6 +34,7 @@ std::array<std::uint8_t, oms::kHeaderBytes> encodeHeader(const CubeTransform& cu
     store(bytes.data() + h::kAttributes, attributes.bits());
     store(bytes.data() + h::kRecordBytes,
           static_cast<std::uint16_t>(oms::RecordLayout::of(attributes).bytes));
+    store(bytes.data() + h::kExtraBytes, attributes.extraBytes());
     for (int axis = 0; axis < 3; ++axis) {
         store(bytes.data() + h::kCubeOrigin + 8 * axis, cube.origin[axis]);
         store(bytes.data() + h::kSourceOffset + 8 * axis, sourceOffset[axis]);
@@ -61,8 +62,13 @@ void OmsWriter::open(const std::string& path, const CubeTransform& cube,
     if (pointCount == 0) {
         fail("a .oms file holds at least one point, got 0");
     }
-    if ((attributes.bits() & ~oms::kKnownAttributeBits) != 0) {
+    if ((attributes.bits() & ~oms::kKnownAttributeBits) != 0 || !attributes.valid()) {
         fail("unknown attribute bits " + std::to_string(attributes.bits()));
+    }
+    if (oms::RecordLayout::of(attributes).bytes > 0xFFFF) {
+        fail("a point record of " + std::to_string(oms::RecordLayout::of(attributes).bytes) +
+             " bytes (" + std::to_string(attributes.extraBytes()) +
+             " LAS extra bytes) exceeds the 65535 a .oms record may hold");
     }
     if (!isFinite(cube.origin) || !isFinite(sourceOffset) || !std::isfinite(cube.edge) ||
         !(cube.edge > 0.0)) {
@@ -124,6 +130,7 @@ void OmsWriter::append(const SortedCloud& cloud, std::size_t begin, std::size_t 
             if (m_attributes.has(Attribute::Intensity)) {
                 store(record + m_layout.intensityOffset, intensities[i]);
             }
+            std::memcpy(record + m_layout.lasOffset, cloud.lasRecord(i), m_layout.lasBytes);
         }
         m_checksum->update(m_block.data(), m_block.size());
         m_file->write(m_block.data(), m_block.size());

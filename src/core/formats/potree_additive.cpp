@@ -17,7 +17,8 @@ public:
         : m_cloud(cloud), m_byIndex(cloud.order() == CloudOrder::Morton),
           m_normals(cloud.attributes().has(Attribute::Normal)),
           m_colors(cloud.attributes().has(Attribute::Color)),
-          m_intensities(cloud.attributes().has(Attribute::Intensity)) {}
+          m_intensities(cloud.attributes().has(Attribute::Intensity)),
+          m_lasBytes(cloud.attributes().lasBytes()) {}
 
     bool operator()(std::uint32_t a, std::uint32_t b) const {
         if (a == b) {
@@ -38,12 +39,17 @@ public:
         if (m_colors && m_cloud.color(a) != m_cloud.color(b)) {
             return false;
         }
-        return !m_intensities || m_cloud.intensities()[a] == m_cloud.intensities()[b];
+        if (m_intensities && m_cloud.intensities()[a] != m_cloud.intensities()[b]) {
+            return false;
+        }
+        return m_lasBytes == 0 ||
+               std::memcmp(m_cloud.lasRecord(a), m_cloud.lasRecord(b), m_lasBytes) == 0;
     }
 
 private:
     const SortedCloud& m_cloud;
     bool m_byIndex, m_normals, m_colors, m_intensities;
+    std::size_t m_lasBytes;
 };
 
 std::string describe(int level, std::size_t index, const OctreeNode& node) {

@@ -1,5 +1,7 @@
 #include "formats/potree_attributes.hpp"
 
+#include "points/las_fields.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -52,6 +54,26 @@ std::string declarationJson(const Declaration& d, const std::string& indent) {
     return json;
 }
 
+// The LAS fields of a record, in PotreeConverter's order for LAS input.
+struct LasFieldSpec {
+    const char* name;
+    int size;
+    const char* type;
+};
+constexpr std::array<LasFieldSpec, 7> kLasFields{{{"return number", 1, "uint8"},
+                                                   {"number of returns", 1, "uint8"},
+                                                   {"classification", 1, "uint8"},
+                                                   {"scan angle", 2, "int16"},
+                                                   {"user data", 1, "uint8"},
+                                                   {"point source id", 2, "uint16"},
+                                                   {"gps-time", 8, "double"}}};
+
+std::array<double, 7> lasFieldValues(const LasFields& f) {
+    return {double(f.returnNumber()), double(f.numberOfReturns()), double(f.classification),
+            double(f.scanAngle),      double(f.userData),          double(f.pointSourceId),
+            f.gpsTime};
+}
+
 } // namespace
 
 std::int32_t potreeQuantize(float unit) {
@@ -62,7 +84,12 @@ std::int32_t potreeQuantize(float unit) {
 PotreeRecordEncoder::PotreeRecordEncoder(const SortedCloud& cloud)
     : m_cloud(cloud), m_color(cloud.attributes().has(Attribute::Color)),
       m_intensity(cloud.attributes().has(Attribute::Intensity)),
-      m_recordBytes(12 + (m_intensity ? 2 : 0) + (m_color ? 6 : 0)) {
+      m_las(cloud.attributes().has(Attribute::Las)),
+      m_gpsTime(cloud.attributes().has(Attribute::GpsTime)),
+      m_recordBytes(12 + (m_intensity ? 2 : 0) + (m_las ? 8 : 0) + (m_gpsTime ? 8 : 0) +
+                    (m_color ? 6 : 0)) {
+    m_lasMin.fill(std::numeric_limits<double>::max());
+    m_lasMax.fill(std::numeric_limits<double>::lowest());
     m_positionMin.fill(std::numeric_limits<std::int32_t>::max());
     m_positionMax.fill(std::numeric_limits<std::int32_t>::min());
     m_rgbMin.fill(65535);
@@ -86,6 +113,25 @@ void PotreeRecordEncoder::encode(std::uint32_t index, std::uint8_t* record) {
         m_intensityMin = std::min(m_intensityMin, value);
         m_intensityMax = std::max(m_intensityMax, value);
         at += 2;
+    }
+    if (m_las) {
+        const LasFields fields = decodeLasFields(m_cloud.attributes(), m_cloud.lasRecord(index));
+        record[at] = static_cast<std::uint8_t>(fields.returnNumber());
+        record[at + 1] = static_cast<std::uint8_t>(fields.numberOfReturns());
+        record[at + 2] = fields.classification;
+        store(record + at + 3, fields.scanAngle);
+        record[at + 5] = fields.userData;
+        store(record + at + 6, fields.pointSourceId);
+        at += 8;
+        if (m_gpsTime) {
+            store(record + at, fields.gpsTime);
+            at += 8;
+        }
+        const std::array<double, 7> values = lasFieldValues(fields);
+        for (std::size_t f = 0; f < values.size(); ++f) {
+            m_lasMin[f] = std::min(m_lasMin[f], values[f]);
+            m_lasMax[f] = std::max(m_lasMax[f], values[f]);
+        }
     }
     if (m_color) {
         const glm::u8vec3 color = m_cloud.color(index);
@@ -118,6 +164,21 @@ std::string PotreeRecordEncoder::attributesJson(double scale, const std::array<d
                                                    {double(any ? m_intensityMin : 0)},
                                                    {double(any ? m_intensityMax : 0)}},
                                                   indent));
+    }
+    if (m_las) {
+        for (std::size_t f = 0; f < kLasFields.size(); ++f) {
+            if (f + 1 == kLasFields.size() && !m_gpsTime) {
+                break;
+            }
+            const LasFieldSpec& spec = kLasFields[f];
+            json.append(",\n").append(declarationJson({spec.name,
+                                                       1,
+                                                       spec.size,
+                                                       spec.type,
+                                                       {any ? m_lasMin[f] : 0.0},
+                                                       {any ? m_lasMax[f] : 0.0}},
+                                                      indent));
+        }
     }
     if (m_color) {
         Declaration rgb{"rgb", 3, 2, "uint16", {}, {}};

@@ -2,6 +2,10 @@
 // point in octree.bin) and its declaration in metadata.json, as PotreeConverter 2 writes them:
 //   position   int32 x 3   stored = floor(unit x 2^30), value = stored x scale + offset
 //   intensity  uint16      when the cloud has it
+//   LAS fields             when the cloud was read from LAS or LAZ: return number, number of
+//                          returns, classification (uint8), scan angle (int16, 0.006 degree
+//                          steps), user data (uint8), point source id (uint16), gps-time
+//                          (double, where the source had it)
 //   rgb        uint16 x 3  when the cloud has it: the 8-bit colour x 257 (Potree's loaders take
 //                          values above 255 as 16-bit, so 255 reads back as 255)
 // in PotreeConverter's order for LAS input (position, intensity, ..., rgb). Each declaration
@@ -30,6 +34,7 @@ public:
     std::size_t recordBytes() const { return m_recordBytes; }
     bool hasColor() const { return m_color; }
     bool hasIntensity() const { return m_intensity; }
+    bool hasLasFields() const { return m_las; }
 
     // Writes point `index` of the cloud into `record` (recordBytes() bytes) and widens each
     // attribute's range by it.
@@ -42,8 +47,10 @@ public:
 
 private:
     const SortedCloud& m_cloud;
-    bool m_color, m_intensity;
+    bool m_color, m_intensity, m_las, m_gpsTime;
     std::size_t m_recordBytes;
+    // Ranges of the LAS fields, in record order (kLasFields in the .cpp).
+    std::array<double, 7> m_lasMin, m_lasMax;
     std::array<std::int32_t, 3> m_positionMin, m_positionMax;
     std::array<std::uint16_t, 3> m_rgbMin, m_rgbMax;
     std::uint16_t m_intensityMin, m_intensityMax;

@@ -32,6 +32,7 @@ namespace {
 // export holds the cloud's copy once, not a second filtered one.
 void keepInsideBox(PointBatch& points, const ClipBox& box) {
     const AttributeSet attributes = points.attributes;
+    const std::size_t lasBytes = attributes.lasBytes();
     std::size_t kept = 0;
     for (std::size_t i = 0; i < points.size(); ++i) {
         if (!box.contains(glm::dvec3(points.positions[i]))) {
@@ -47,6 +48,8 @@ void keepInsideBox(PointBatch& points, const ClipBox& box) {
         if (attributes.has(Attribute::Intensity)) {
             points.intensities[kept] = points.intensities[i];
         }
+        std::copy_n(points.las.begin() + static_cast<std::ptrdiff_t>(i * lasBytes), lasBytes,
+                    points.las.begin() + static_cast<std::ptrdiff_t>(kept * lasBytes));
         ++kept;
     }
     points.positions.resize(kept);
@@ -59,6 +62,7 @@ void keepInsideBox(PointBatch& points, const ClipBox& box) {
     if (attributes.has(Attribute::Intensity)) {
         points.intensities.resize(kept);
     }
+    points.las.resize(kept * lasBytes);
 }
 
 } // namespace
@@ -87,16 +91,32 @@ std::uint64_t exportCloudPoints(const std::string& path, const SortedCloud& clou
         writePly(path, points, cloud.cube(), options);
         return points.size();
     }
+    const LasWriteOptions options = lasExportOptions(cloud.attributes(), cloud.cube());
+    writeLas(path, points, cloud.cube(), options);
+    return points.size();
+}
+
+LasWriteOptions lasExportOptions(AttributeSet attributes, const CubeTransform& cube) {
     LasWriteOptions options;
-    options.pointFormat = cloud.attributes().has(Attribute::Color) ? 2 : 0;
+    const bool color = attributes.has(Attribute::Color);
+    if (attributes.has(Attribute::Las)) {
+        // Every LAS field back: LAS 1.4's formats keep full classes, scan angles and NIR.
+        options.versionMinor = 4;
+        options.pointFormat = attributes.has(Attribute::Nir) ? 8 : color ? 7 : 6;
+        options.extraBytesPerRecord = attributes.extraBytes();
+        if (attributes.extraBytes() != 0) {
+            options.vlrs.push_back(undocumentedExtraBytesRecord(attributes.extraBytes()));
+        }
+    } else {
+        options.pointFormat = color ? 2 : 0;
+    }
     // Integers relative to the cube's corner, with the finest power-of-ten step that keeps the
     // largest coordinate (the cube's edge) below 10^9 < 2^31: sub-millimetre for a building,
     // still exact enough for a 10 cm statue.
-    options.offset = cloud.cube().origin;
-    const double step = std::pow(10.0, std::ceil(std::log10(cloud.cube().edge / 1e9)));
+    options.offset = cube.origin;
+    const double step = std::pow(10.0, std::ceil(std::log10(cube.edge / 1e9)));
     options.scale = glm::dvec3(step);
-    writeLas(path, points, cloud.cube(), options);
-    return points.size();
+    return options;
 }
 
 } // namespace omicron

@@ -23,16 +23,7 @@ double secondsSince(Clock::time_point start) {
 void copySlice(const PointBatch& from, std::size_t begin, std::size_t end, PointBatch& to) {
     to.clear();
     to.attributes = from.attributes;
-    const auto slice = [&](const auto& source, auto& target) {
-        if (!source.empty()) {
-            target.assign(source.begin() + static_cast<std::ptrdiff_t>(begin),
-                          source.begin() + static_cast<std::ptrdiff_t>(end));
-        }
-    };
-    slice(from.positions, to.positions);
-    slice(from.normals, to.normals);
-    slice(from.colors, to.colors);
-    slice(from.intensities, to.intensities);
+    to.appendRange(from, begin, end);
 }
 
 std::string describeCloud(const CloudInfo& info) {

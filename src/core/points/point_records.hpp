@@ -1,6 +1,6 @@
 // Fixed-size binary records of one point: its unit-cube position and attributes packed as
-// x y z [nx ny nz] [r g b] [intensity] (host floats, little-endian), absent attributes taking
-// no bytes. The record of a .oms sorted stream and of the sorter's scratch runs.
+// x y z [nx ny nz] [r g b] [intensity] [LAS column] (host floats, little-endian), absent
+// attributes taking no bytes. The record of a .oms sorted stream and of the sorter's scratch runs.
 #pragma once
 
 #include "points/point_batch.hpp"
@@ -19,6 +19,8 @@ struct PointRecordLayout {
     std::size_t normalOffset = 0;
     std::size_t colorOffset = 0;
     std::size_t intensityOffset = 0;
+    std::size_t lasOffset = 0;
+    std::size_t lasBytes = 0;
     std::size_t bytes = 0;
 
     static constexpr PointRecordLayout of(AttributeSet attributes) {
@@ -36,6 +38,9 @@ struct PointRecordLayout {
             layout.intensityOffset = at;
             at += sizeof(std::uint16_t);
         }
+        layout.lasOffset = at;
+        layout.lasBytes = attributes.lasBytes();
+        at += layout.lasBytes;
         layout.bytes = at;
         return layout;
     }
@@ -54,6 +59,10 @@ inline void encodePointRecord(const PointRecordLayout& layout, const PointBatch&
     if (points.attributes.has(Attribute::Intensity)) {
         std::memcpy(record + layout.intensityOffset, &points.intensities[index],
                     sizeof(std::uint16_t));
+    }
+    if (layout.lasBytes != 0) {
+        std::memcpy(record + layout.lasOffset, points.las.data() + index * layout.lasBytes,
+                    layout.lasBytes);
     }
 }
 
@@ -77,6 +86,10 @@ inline void decodePointRecord(const PointRecordLayout& layout, const std::uint8_
         std::uint16_t intensity;
         std::memcpy(&intensity, record + layout.intensityOffset, sizeof intensity);
         points.intensities.push_back(intensity);
+    }
+    if (layout.lasBytes != 0) {
+        points.las.insert(points.las.end(), record + layout.lasOffset,
+                          record + layout.lasOffset + layout.lasBytes);
     }
 }
 

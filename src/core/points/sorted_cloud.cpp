@@ -29,6 +29,7 @@ SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffs
       m_colors(storage == PointStorage::Exact && attributes.has(Attribute::Color) ? capacity : 0,
                pages),
       m_intensities(attributes.has(Attribute::Intensity) ? capacity : 0, pages),
+      m_las(capacity * attributes.lasBytes(), pages),
       m_blockCodes(order == CloudOrder::Morton ? blockCodeCount(capacity) : 0) {
     if (pages == PageSize::Small &&
         (storage != PointStorage::Exact || order != CloudOrder::NodeOrder)) {
@@ -49,12 +50,14 @@ SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffs
       m_normals(attributes.has(Attribute::Normal) ? capacity : 0, backing),
       m_colors(attributes.has(Attribute::Color) ? capacity : 0, backing),
       m_intensities(attributes.has(Attribute::Intensity) ? capacity : 0, backing),
+      m_las(capacity * attributes.lasBytes(), backing),
       m_blockCodes(blockCodeCount(capacity)) {
     m_governor = std::make_unique<ResidentSetGovernor>(budgetBytes, [this] {
         m_positions.dropResident();
         m_normals.dropResident();
         m_colors.dropResident();
         m_intensities.dropResident();
+        m_las.dropResident();
     });
 }
 
@@ -68,8 +71,12 @@ SortedCloud::StagedRange SortedCloud::stage(std::size_t end) {
         return array.size() == 0 ? std::span<std::remove_reference_t<decltype(array[0])>>()
                                  : std::span(array.data() + begin, count);
     };
+    const std::size_t lasBytes = m_attributes.lasBytes();
     StagedRange staged{inPlace(m_positions), inPlace(m_normals), inPlace(m_colors),
-                       inPlace(m_intensities)};
+                       inPlace(m_intensities),
+                       lasBytes == 0 ? std::span<std::uint8_t>()
+                                     : std::span(m_las.data() + begin * lasBytes,
+                                                 count * lasBytes)};
     if (m_packed) {
         m_stagedPositions.resize(count);
         staged.positions = m_stagedPositions;
@@ -114,7 +121,8 @@ void SortedCloud::markComplete() {
 
 std::size_t SortedCloud::bytesResident() const {
     const std::size_t arrays = positions().size_bytes() + normals().size_bytes() +
-                               colors().size_bytes() + intensities().size_bytes();
+                               colors().size_bytes() + intensities().size_bytes() +
+                               lasColumn().size_bytes();
     return (fileBacked() ? 0 : arrays) + m_blockCodes.size() * sizeof(morton::Code) +
            (m_packed ? m_packed->bytesResident() : 0);
 }
@@ -127,6 +135,8 @@ void SortedCloud::willRead(std::size_t begin, std::size_t end) const {
     m_normals.willRead(begin, end);
     m_colors.willRead(begin, end);
     m_intensities.willRead(begin, end);
+    const std::size_t lasBytes = m_attributes.lasBytes();
+    m_las.willRead(begin * lasBytes, end * lasBytes);
 }
 
 std::uint64_t SortedCloud::residentDrops() const {
@@ -156,6 +166,8 @@ void SortedCloud::copyRange(std::size_t begin, std::size_t end, PointBatch& out)
     };
     copyInto(normals(), out.normals);
     copyInto(intensities(), out.intensities);
+    const std::size_t lasBytes = m_attributes.lasBytes();
+    out.las.assign(m_las.data() + begin * lasBytes, m_las.data() + end * lasBytes);
 }
 
 } // namespace omicron

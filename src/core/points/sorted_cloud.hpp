@@ -117,12 +117,19 @@ public:
     // Either store keeps these as read.
     std::span<const glm::vec3> normals() const { return m_normals; }
     std::span<const std::uint16_t> intensities() const { return m_intensities; }
+    // The LAS column (points/las_fields.hpp), attributes().lasBytes() bytes a point; empty
+    // without Attribute::Las.
+    std::span<const std::uint8_t> lasColumn() const { return m_las; }
+    const std::uint8_t* lasRecord(std::size_t i) const {
+        return m_las.data() + i * m_attributes.lasBytes();
+    }
 
     // Producer side. The exact store is written in place, beyond sortedEnd(), then published:
     std::span<glm::vec3> mutablePositions() { return m_positions; }
     std::span<glm::vec3> mutableNormals() { return m_normals; }
     std::span<glm::u8vec3> mutableColors() { return m_colors; }
     std::span<std::uint16_t> mutableIntensities() { return m_intensities; }
+    std::span<std::uint8_t> mutableLasColumn() { return m_las; }
     // ...or, for either store, the next points [sortedEnd(), end) are written through the spans
     // stage() returns (indexed from 0; an attribute the cloud lacks is empty) and published by
     // publish(end). For a packed cloud positions and colours go to a staging buffer that
@@ -132,6 +139,7 @@ public:
         std::span<glm::vec3> normals;
         std::span<glm::u8vec3> colors;
         std::span<std::uint16_t> intensities;
+        std::span<std::uint8_t> las; // lasBytes() bytes a point
     };
     StagedRange stage(std::size_t end);
 
@@ -178,6 +186,7 @@ private:
     HugePageArray<glm::vec3> m_normals;
     HugePageArray<glm::u8vec3> m_colors;
     HugePageArray<std::uint16_t> m_intensities;
+    HugePageArray<std::uint8_t> m_las;
     HugePageArray<morton::Code> m_blockCodes;    // CloudOrder::Morton only
     std::unique_ptr<PackedPointStore> m_packed; // Packed storage only
     std::vector<glm::vec3> m_stagedPositions;   // Packed: the range stage() handed out

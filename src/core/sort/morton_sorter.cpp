@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <tbb/parallel_for.h>
@@ -194,6 +195,7 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                    });
                    // Gather every attribute into its sorted place.
                    const SortedCloud::StagedRange out = cloud.stage(chunkBegin[c + 1]);
+                   const std::size_t lasBytes = m_input.attributes.lasBytes();
                    tbb::parallel_for(
                        tbb::blocked_range<std::size_t>(0, size, 8192),
                        [&](const tbb::blocked_range<std::size_t>& range) {
@@ -208,6 +210,10 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                                }
                                if (!m_input.intensities.empty()) {
                                    out.intensities[i] = m_input.intensities[from];
+                               }
+                               if (lasBytes != 0) {
+                                   std::memcpy(out.las.data() + i * lasBytes,
+                                               m_input.las.data() + from * lasBytes, lasBytes);
                                }
                            }
                        });
@@ -248,6 +254,7 @@ int IncrementalMortonSorter::mergeAndEmit(const SortedRangeConsumer& consumer) {
         std::copy(sorted.normals.begin(), sorted.normals.end(), out.normals.begin());
         std::copy(sorted.colors.begin(), sorted.colors.end(), out.colors.begin());
         std::copy(sorted.intensities.begin(), sorted.intensities.end(), out.intensities.begin());
+        std::copy(sorted.las.begin(), sorted.las.end(), out.las.begin());
         cloud.publish(end + n);
         if (m_firstRangeSeconds < 0.0) {
             m_firstRangeSeconds = secondsSince(start);

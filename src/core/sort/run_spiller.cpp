@@ -47,22 +47,7 @@ void RunSpiller::add(const PointBatch& batch, std::span<const morton::Code> code
     for (std::size_t first = 0; first < batch.size();) {
         const std::size_t room = m_runPoints - m_buffer.size();
         const std::size_t take = std::min(room, batch.size() - first);
-        if (first == 0 && take == batch.size()) {
-            m_buffer.append(batch);
-        } else {
-            PointBatch part;
-            part.attributes = batch.attributes;
-            const auto slice = [&](const auto& from, auto& to) {
-                if (!from.empty()) {
-                    to.assign(from.begin() + first, from.begin() + first + take);
-                }
-            };
-            slice(batch.positions, part.positions);
-            slice(batch.normals, part.normals);
-            slice(batch.colors, part.colors);
-            slice(batch.intensities, part.intensities);
-            m_buffer.append(part);
-        }
+        m_buffer.appendRange(batch, first, first + take);
         m_codes.insert(m_codes.end(), codes.begin() + first, codes.begin() + first + take);
         first += take;
         if (m_buffer.size() == m_runPoints) {

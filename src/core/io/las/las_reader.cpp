@@ -4,6 +4,7 @@
 #include "io/input_error.hpp"
 #include "io/las/las_file_records.hpp"
 #include "io/las/las_header.hpp"
+#include "io/las/las_point_fields.hpp"
 #include "io/laz/laz_records.hpp"
 #include "io/pre_pass_monitor.hpp"
 #include "io/source_normalizer.hpp"
@@ -50,9 +51,8 @@ public:
         m_info.format = format;
         m_info.pointCount = m_header.pointCount;
         m_info.sourceOffset = m_header.offset;
-        m_info.attributes.add(Attribute::Intensity);
+        m_info.attributes = las::attributesOfFormat(m_header.pointFormat, m_header.recordLength);
         if (las::formatHasColor(m_header.pointFormat)) {
-            m_info.attributes.add(Attribute::Color);
             m_colorOffset = las::colorOffset(m_header.pointFormat);
             m_colorDepth = sampleColorDepth();
         }
@@ -140,6 +140,9 @@ private:
         if (extraBytes > 0) {
             detail += " (" + std::to_string(extraBytes) + " extra bytes)";
         }
+        if (las::formatHasWaveform(m_header.pointFormat)) {
+            detail += ", waveform packets ignored";
+        }
         const std::string storage = m_records->describe();
         if (!storage.empty()) {
             detail += ", " + storage;
@@ -196,6 +199,9 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
     const Bounds& bounds = m_info.sourceBounds;
     const bool hasColor = m_colorDepth != ColorDepth::None;
     const std::size_t stride = m_header.recordLength;
+    const AttributeSet attributes = m_info.attributes;
+    const LasColumnLayout lasLayout = LasColumnLayout::of(attributes);
+    const std::size_t extraAt = las::minimumRecordLength(m_header.pointFormat);
 
     const auto deliver = [&] {
         consumer(batch);
@@ -216,6 +222,10 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
             if (hasColor) {
                 batch.colors.push_back(color(record));
             }
+            batch.las.resize(batch.las.size() + lasLayout.bytes);
+            std::uint8_t* column = batch.las.data() + batch.las.size() - lasLayout.bytes;
+            encodeLasFields(attributes, las::readLasFields(record, m_header.pointFormat), column);
+            std::memcpy(column + lasLayout.extraOffset, record + extraAt, lasLayout.extraBytes);
             if (batch.size() == batchPoints) {
                 deliver();
                 const bool morePoints = block.firstIndex + i + 1 < m_header.pointCount;

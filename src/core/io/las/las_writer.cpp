@@ -1,6 +1,7 @@
 #include "io/las/las_writer.hpp"
 
 #include "io/las/las_header.hpp"
+#include "io/las/las_point_fields.hpp"
 
 #include <algorithm>
 #include <array>
@@ -183,6 +184,11 @@ void LasStreamWriter::append(const PointBatch& points, const CubeTransform& cube
     const bool writesColor = las::formatHasColor(format) && points.attributes.has(Attribute::Color);
     const std::size_t colorAt = writesColor ? las::colorOffset(format) : 0;
     const std::uint8_t returnBits = format > 5 ? kSingleReturn14 : kSingleReturnLegacy;
+    const AttributeSet attributes = points.attributes;
+    const LasColumnLayout lasLayout = LasColumnLayout::of(attributes);
+    const std::size_t extraAt = las::minimumRecordLength(format);
+    const std::size_t extraBytes =
+        std::min<std::size_t>(lasLayout.extraBytes, m_options.extraBytesPerRecord);
     constexpr double lowest = std::numeric_limits<std::int32_t>::min();
     constexpr double highest = std::numeric_limits<std::int32_t>::max();
 
@@ -211,7 +217,13 @@ void LasStreamWriter::append(const PointBatch& points, const CubeTransform& cube
             if (hasIntensity) {
                 store(record + las::kRecordIntensity, points.intensities[index]);
             }
-            record[las::kRecordReturnBits] = returnBits;
+            if (lasLayout.bytes != 0) {
+                const std::uint8_t* column = points.las.data() + index * lasLayout.bytes;
+                las::writeLasFields(decodeLasFields(attributes, column), format, record);
+                std::memcpy(record + extraAt, column + lasLayout.extraOffset, extraBytes);
+            } else {
+                record[las::kRecordReturnBits] = returnBits;
+            }
             if (writesColor) {
                 const glm::u8vec3 c = points.colors[index];
                 store(record + colorAt, static_cast<std::uint16_t>(c.r * 257));
@@ -239,6 +251,24 @@ void LasStreamWriter::finish() {
     const std::vector<std::uint8_t> header = headerBytes(m_options, m_pointCount, bounds);
     m_file->writeAt(0, header.data(), header.size());
     m_file->commit();
+}
+
+LasVariableLengthRecord undocumentedExtraBytesRecord(std::uint16_t count) {
+    // One 192-byte descriptor per run of up to 255 bytes: reserved[2], data type, options
+    // (the byte count for type 0), name[32], then limits, scales and a description.
+    constexpr std::size_t kDescriptorBytes = 192;
+    LasVariableLengthRecord vlr;
+    vlr.userId = "LASF_Spec";
+    vlr.recordId = 4;
+    vlr.description = "Extra Bytes Record";
+    for (int first = 0, part = 0; first < count; first += 255, ++part) {
+        std::array<std::uint8_t, kDescriptorBytes> descriptor{};
+        descriptor[3] = static_cast<std::uint8_t>(std::min(255, count - first));
+        storeText(&descriptor[4], 32, "extra " + std::to_string(part));
+        storeText(&descriptor[160], 32, "carried through by omicron");
+        vlr.payload.insert(vlr.payload.end(), descriptor.begin(), descriptor.end());
+    }
+    return vlr;
 }
 
 void writeLas(const std::string& path, const PointBatch& points, const CubeTransform& cube,

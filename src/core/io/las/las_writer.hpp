@@ -29,9 +29,15 @@ struct LasWriteOptions {
     // georeferenced clouds need an offset near the data (e.g. CloudInfo::sourceOffset).
     glm::dvec3 scale{0.001}; // source units per step; finite and > 0
     glm::dvec3 offset{0.0};
-    std::uint16_t extraBytesPerRecord = 0; // zeros after each record's standard fields
+    // Bytes after each record's standard fields: a cloud's LAS extra bytes (as many as fit),
+    // zeros beyond them.
+    std::uint16_t extraBytesPerRecord = 0;
     std::vector<LasVariableLengthRecord> vlrs;
 };
+
+// The LASF_Spec Extra Bytes record (id 4) describing `count` extra bytes per point as
+// undocumented bytes (data type 0), so a LAS 1.4 reader knows their length.
+LasVariableLengthRecord undocumentedExtraBytesRecord(std::uint16_t count);
 
 // A LAS file written in pieces, so memory stays bounded whatever the count: the options are
 // checked and the header (with the count) written when constructed, the records batch after

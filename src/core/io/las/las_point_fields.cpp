@@ -1,0 +1,135 @@
+#include "io/las/las_point_fields.hpp"
+
+#include "io/las/las_header.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace omicron::las {
+
+namespace {
+
+// Record offsets after X, Y, Z (12 bytes) and intensity (2) in the two layouts.
+namespace legacy {
+constexpr std::size_t kReturns = 14;   // return number 0-2, count 3-5, direction 6, edge 7
+constexpr std::size_t kClass = 15;     // class 0-4, synthetic 5, key-point 6, withheld 7
+constexpr std::size_t kScanRank = 16;  // int8, whole degrees
+constexpr std::size_t kUserData = 17;
+constexpr std::size_t kSourceId = 18;
+constexpr std::size_t kGpsTime = 20;
+} // namespace legacy
+namespace v14 {
+constexpr std::size_t kReturns = 14;   // return number 0-3, count 4-7
+constexpr std::size_t kFlags = 15;     // class flags 0-3, channel 4-5, direction 6, edge 7
+constexpr std::size_t kClass = 16;
+constexpr std::size_t kUserData = 17;
+constexpr std::size_t kScanAngle = 18; // int16, 0.006 degrees
+constexpr std::size_t kSourceId = 20;
+constexpr std::size_t kGpsTime = 22;
+constexpr std::size_t kNir = 36;       // formats 8 and 10
+} // namespace v14
+
+// 1 / 0.006: steps of the LAS 1.4 scan angle per degree.
+constexpr double kScanStepsPerDegree = 1000.0 / 6.0;
+
+template <typename T> T load(const std::uint8_t* bytes) {
+    T value;
+    std::memcpy(&value, bytes, sizeof value);
+    return value;
+}
+
+template <typename T> void store(std::uint8_t* bytes, T value) {
+    std::memcpy(bytes, &value, sizeof value);
+}
+
+} // namespace
+
+bool formatHasGpsTime(std::uint8_t pointFormat) {
+    return pointFormat == 1 || (pointFormat >= 3 && pointFormat <= kMaxPointFormat);
+}
+
+bool formatHasNir(std::uint8_t pointFormat) {
+    return pointFormat == 8 || pointFormat == 10;
+}
+
+bool formatHasWaveform(std::uint8_t pointFormat) {
+    return pointFormat == 4 || pointFormat == 5 || pointFormat == 9 || pointFormat == 10;
+}
+
+AttributeSet attributesOfFormat(std::uint8_t pointFormat, std::uint16_t recordLength) {
+    AttributeSet attributes = AttributeSet(Attribute::Intensity) | Attribute::Las;
+    if (formatHasColor(pointFormat)) {
+        attributes.add(Attribute::Color);
+    }
+    if (formatHasGpsTime(pointFormat)) {
+        attributes.add(Attribute::GpsTime);
+    }
+    if (formatHasNir(pointFormat)) {
+        attributes.add(Attribute::Nir);
+    }
+    const int extra = int{recordLength} - int{minimumRecordLength(pointFormat)};
+    attributes.setExtraBytes(static_cast<std::uint16_t>(std::max(extra, 0)));
+    return attributes;
+}
+
+LasFields readLasFields(const std::uint8_t* record, std::uint8_t pointFormat) {
+    LasFields fields;
+    if (pointFormat <= 5) {
+        const std::uint8_t returns = record[legacy::kReturns];
+        const std::uint8_t classByte = record[legacy::kClass];
+        fields.returns = static_cast<std::uint8_t>((returns & 0x07) | ((returns >> 3) & 0x07) << 4);
+        fields.classification = classByte & 0x1f;
+        fields.flags = static_cast<std::uint8_t>((classByte >> 5) | (returns & 0xc0));
+        fields.scanAngle = static_cast<std::int16_t>(
+            std::lround(load<std::int8_t>(record + legacy::kScanRank) * kScanStepsPerDegree));
+        fields.userData = record[legacy::kUserData];
+        fields.pointSourceId = load<std::uint16_t>(record + legacy::kSourceId);
+        if (formatHasGpsTime(pointFormat)) {
+            fields.gpsTime = load<double>(record + legacy::kGpsTime);
+        }
+        return fields;
+    }
+    fields.returns = record[v14::kReturns];
+    fields.flags = record[v14::kFlags];
+    fields.classification = record[v14::kClass];
+    fields.userData = record[v14::kUserData];
+    fields.scanAngle = load<std::int16_t>(record + v14::kScanAngle);
+    fields.pointSourceId = load<std::uint16_t>(record + v14::kSourceId);
+    fields.gpsTime = load<double>(record + v14::kGpsTime);
+    if (formatHasNir(pointFormat)) {
+        fields.nir = load<std::uint16_t>(record + v14::kNir);
+    }
+    return fields;
+}
+
+void writeLasFields(const LasFields& fields, std::uint8_t pointFormat, std::uint8_t* record) {
+    if (pointFormat <= 5) {
+        const int number = std::min(fields.returnNumber(), 7);
+        const int count = std::min(fields.numberOfReturns(), 7);
+        record[legacy::kReturns] =
+            static_cast<std::uint8_t>(number | count << 3 | (fields.flags & 0xc0));
+        record[legacy::kClass] = static_cast<std::uint8_t>(
+            std::min<int>(fields.classification, 31) | (fields.flags & 0x07) << 5);
+        const long degrees = std::lround(fields.scanAngleDegrees());
+        store(record + legacy::kScanRank, static_cast<std::int8_t>(std::clamp(degrees, -90L, 90L)));
+        record[legacy::kUserData] = fields.userData;
+        store(record + legacy::kSourceId, fields.pointSourceId);
+        if (formatHasGpsTime(pointFormat)) {
+            store(record + legacy::kGpsTime, fields.gpsTime);
+        }
+        return;
+    }
+    record[v14::kReturns] = fields.returns;
+    record[v14::kFlags] = fields.flags;
+    record[v14::kClass] = fields.classification;
+    record[v14::kUserData] = fields.userData;
+    store(record + v14::kScanAngle, fields.scanAngle);
+    store(record + v14::kSourceId, fields.pointSourceId);
+    store(record + v14::kGpsTime, fields.gpsTime);
+    if (formatHasNir(pointFormat)) {
+        store(record + v14::kNir, fields.nir);
+    }
+}
+
+} // namespace omicron::las
