@@ -49,15 +49,10 @@ struct TileGrid {
     }
 };
 
-// LAS records have no normals.
+// LAS records have no normals; every other attribute (the LAS fields of a LAS input) stays.
 AttributeSet withoutNormals(AttributeSet attributes) {
-    AttributeSet kept;
-    for (Attribute attribute : {Attribute::Color, Attribute::Intensity}) {
-        if (attributes.has(attribute)) {
-            kept.add(attribute);
-        }
-    }
-    return kept;
+    return AttributeSet::fromBits(attributes.bits() & ~static_cast<std::uint8_t>(Attribute::Normal),
+                                  attributes.extraBytes());
 }
 
 using TileWriter = std::variant<std::unique_ptr<PlyStreamWriter>, std::unique_ptr<LasStreamWriter>>;

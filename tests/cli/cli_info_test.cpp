@@ -120,5 +120,29 @@ TEST(CliInfo, UnderstandsSortedStreams) {
     EXPECT_NE(info.out.find("\"min\":[636001.7"), std::string::npos) << info.out;
 }
 
+// The class counts are those of the uncompressed twin decoded by another LAZ implementation
+// (counted from its raw records by LasAttributes.StatisticsCountTheClassesOfTheFile).
+TEST(CliInfo, ListsEveryLasAttributeWithItsRangeAndTheClasses) {
+    OMICRON_REQUIRE_SHARED_FILE(path, "laz/terrascan_fmt8.laz");
+    const auto text = runProcess(OMICRON_CLI_PATH, {"info", path});
+    ASSERT_EQ(text.exitCode, 0) << text.err;
+    for (const char* line :
+         {"classification, classification flags, return number, number of returns, scan angle, "
+          "user data, point source id, scanner channel, scan direction, edge of flight line, "
+          "gps time, nir, extra bytes (3)",
+          "  return number          1 .. 6", "  point source id        47 .. 47",
+          "  class   2 Ground                   683023 points",
+          "  class  65 User 65                  10 points"}) {
+        EXPECT_NE(text.out.find(line), std::string::npos) << line << "\n" << text.out;
+    }
+    const auto json = runProcess(OMICRON_CLI_PATH, {"info", path, "--json"});
+    ASSERT_EQ(json.exitCode, 0) << json.err;
+    EXPECT_NE(json.out.find("\"classes\":{\"1\":3262,\"2\":683023,\"3\":960,\"4\":873,"
+                            "\"5\":9003,\"6\":590,\"65\":10}"),
+              std::string::npos)
+        << json.out;
+    EXPECT_NE(json.out.find("\"return number\":[1,6]"), std::string::npos) << json.out;
+}
+
 } // namespace
 } // namespace omicron

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <csignal>
 #include <filesystem>
+#include <cstring>
 #include <gtest/gtest.h>
 #include <string>
 #include <thread>
@@ -99,6 +100,13 @@ TEST(CliTile, LasCopiesKeepIntensityAndColourWithTheGap) {
         for (std::size_t i = 0; i < in.points.size(); i += 97) {
             ASSERT_EQ(tiled.points.intensities[copy * in.points.size() + i],
                       in.points.intensities[i]);
+            // The LAS fields too (classification, returns, GPS time...), byte for byte.
+            const std::size_t lasBytes = in.points.attributes.lasBytes();
+            ASSERT_EQ(tiled.points.attributes.lasBytes(), lasBytes);
+            ASSERT_EQ(std::memcmp(&tiled.points.las[(copy * in.points.size() + i) * lasBytes],
+                                  &in.points.las[i * lasBytes], lasBytes),
+                      0)
+                << "point " << i << " of copy " << copy;
         }
     }
 }

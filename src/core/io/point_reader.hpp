@@ -55,6 +55,13 @@ struct OpenOptions {
     // finite points over the file, so a viewer can draw the cloud in a provisional frame
     // while its bounds are still being found (the first pixels of a large PLY or XYZ file).
     std::function<void(std::span<const glm::dvec3> sourcePositions)> onPrePassPoints;
+    // Called once at opening, on the opening thread, for a cloud with a level of detail of its
+    // own (COPC): the points of its top levels (about kPrePassSamplePoints), source positions
+    // and colours (empty without colour), a uniform sample of the whole cloud that a viewer can
+    // draw until the sorted points catch up.
+    std::function<void(std::span<const glm::dvec3> sourcePositions,
+                       std::span<const glm::u8vec3> colors)>
+        onHierarchyPreview;
 };
 
 // About how many points the bounds pre-pass samples for OpenOptions::onPrePassPoints.

@@ -186,6 +186,7 @@ void BuildPipeline::beginRun(BuildPhase phase) {
     {
         std::lock_guard lock(m_mutex);
         m_provisional.clear();
+        m_hierarchyPreview.reset();
     }
     m_generation.fetch_add(1);
     setPhase(phase);
@@ -257,6 +258,13 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
         m_provisional.insert(m_provisional.end(), sampled.begin(),
                              sampled.begin() + std::min(room, sampled.size()));
     };
+    std::vector<glm::dvec3> hierarchyPositions;
+    std::vector<glm::u8vec3> hierarchyColors;
+    openOptions.onHierarchyPreview = [&](std::span<const glm::dvec3> positions,
+                                         std::span<const glm::u8vec3> colors) {
+        hierarchyPositions.assign(positions.begin(), positions.end());
+        hierarchyColors.assign(colors.begin(), colors.end());
+    };
     std::unique_ptr<PointReader> reader;
     try {
         reader = openPointCloud(path, openOptions);
@@ -291,6 +299,16 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
         std::lock_guard lock(m_mutex);
         m_sorter = sorter;
         m_provisional = {};
+        if (!hierarchyPositions.empty()) {
+            PreviewSample preview;
+            preview.positions.reserve(hierarchyPositions.size());
+            for (const glm::dvec3& p : hierarchyPositions) {
+                preview.positions.push_back(info.cube.toUnit(p));
+            }
+            preview.colors = std::move(hierarchyColors);
+            preview.pointsSeen = info.pointCount; // it stands for the whole cloud
+            m_hierarchyPreview = std::move(preview);
+        }
     }
     const auto builder = startBuilder(options.build);
     m_sourceReads.fetch_add(1);
@@ -489,6 +507,12 @@ PreviewSample BuildPipeline::preview() const {
             }
             provisional.pointsSeen = m_provisional.size();
             provisional.provisional = true;
+        }
+    }
+    {
+        std::lock_guard lock(m_mutex);
+        if (sorter && m_hierarchyPreview) {
+            return *m_hierarchyPreview;
         }
     }
     return sorter ? sorter->preview() : provisional;

@@ -168,9 +168,11 @@ public:
 
     // ---- Any thread. ----
     PipelineProgress progress() const;
-    // The sorter's random sample while pipeline 1 reads; before that, while a PLY or XYZ file
-    // is scanned for its bounds, a provisional one (PreviewSample::provisional: positions in
-    // the unit cube of the sample's own bounds so far); empty otherwise.
+    // The sorter's random sample while pipeline 1 reads (a COPC file: its hierarchy's top
+    // levels instead, a uniform sample of the whole cloud from the moment it is opened);
+    // before that, while a PLY or XYZ file is scanned for its bounds, a provisional one
+    // (PreviewSample::provisional: positions in the unit cube of the sample's own bounds so
+    // far); empty otherwise.
     PreviewSample preview() const;
     // Valid once the source is opened (cube, attributes, counts).
     std::optional<PipelineSource> source() const;
@@ -221,6 +223,8 @@ private:
     std::shared_ptr<const SortedCloud> m_cloud;
     std::shared_ptr<const IncrementalMortonSorter> m_sorter; // only while pipeline 1 reads
     std::vector<glm::dvec3> m_provisional; // the bounds pre-pass's sample, source units
+    // A COPC file's top levels (OpenOptions::onHierarchyPreview), in the cloud's unit cube.
+    std::optional<PreviewSample> m_hierarchyPreview;
     std::shared_ptr<HierarchyBuilder> m_builder;
     // Pipeline 3: the loaded hierarchy and its statistics (from the file), without a builder.
     std::shared_ptr<const Hierarchy> m_loaded;

@@ -89,6 +89,9 @@ void expectSameHierarchy(const Hierarchy& built, const Hierarchy& loaded) {
                 if (a.attributes().has(Attribute::Intensity)) {
                     ASSERT_EQ(a.intensities()[u], b.intensities()[v]);
                 }
+                const std::size_t lasBytes = a.attributes().lasBytes();
+                ASSERT_EQ(std::memcmp(a.lasRecord(u), b.lasRecord(v), lasBytes), 0)
+                    << "the LAS fields of held point " << p;
             }
         }
     }
@@ -134,7 +137,8 @@ TEST_P(OmhSharedFileRoundTrip, EveryCollapseModeIsBitExact) {
 
 INSTANTIATE_TEST_SUITE_P(SharedData, OmhSharedFileRoundTrip,
                          ::testing::Values("bunny.ply", "dragon.ply", "lion.ply", "indoor.ply",
-                                           "sorvilier.ply", "autzen_trim.ply", "autzen_trim.las"));
+                                           "sorvilier.ply", "autzen_trim.ply", "autzen_trim.las",
+                                           "laz/terrascan_fmt8.laz"));
 
 // 4.8M points: one mode at a small depth keeps the suite fast on two cores.
 TEST(OmhRoundTrip, AutzenSouthAtDepthFiveIsBitExact) {

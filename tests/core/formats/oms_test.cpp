@@ -65,6 +65,9 @@ PointBatch makeBatch(std::size_t count, AttributeSet attributes, std::uint32_t s
         if (attributes.has(Attribute::Intensity)) {
             batch.intensities.push_back(static_cast<std::uint16_t>(random() % 65536));
         }
+        for (std::size_t b = 0; b < attributes.lasBytes(); ++b) {
+            batch.las.push_back(static_cast<std::uint8_t>(random()));
+        }
     }
     return batch;
 }
@@ -104,6 +107,9 @@ void expectSameCloud(const SortedCloud& expected, const SortedCloud& got) {
     EXPECT_EQ(got.intensities().size(), expected.intensities().size());
     EXPECT_TRUE(expected.intensities().empty() ||
                 sameBits(expected.intensities(), got.intensities(), n));
+    EXPECT_EQ(got.lasColumn().size(), expected.lasColumn().size());
+    EXPECT_TRUE(std::equal(expected.lasColumn().begin(), expected.lasColumn().end(),
+                           got.lasColumn().begin(), got.lasColumn().end()));
 }
 
 // What the consumer saw, call by call.
@@ -298,13 +304,12 @@ TEST(OmsFormat, WriterPutsEveryFieldAtItsDocumentedOffset) {
 
 class OmsRoundTripAttributes : public ::testing::TestWithParam<std::uint8_t> {};
 
+// The parameter is the attribute bits; with NIR (a LAS 1.4 format 8 cloud) 5 extra bytes too.
 TEST_P(OmsRoundTripAttributes, GeneratedCloudReadsBackBitExact) {
-    AttributeSet attributes;
-    for (Attribute a : {Attribute::Normal, Attribute::Color, Attribute::Intensity}) {
-        if ((GetParam() & static_cast<std::uint8_t>(a)) != 0) {
-            attributes.add(a);
-        }
-    }
+    const std::uint8_t bits = GetParam();
+    const AttributeSet attributes =
+        AttributeSet::fromBits(bits, (bits & static_cast<std::uint8_t>(Attribute::Nir)) ? 5 : 0);
+    ASSERT_TRUE(attributes.valid());
     test::TempDir dir;
     const std::string path = dir.file("generated.oms");
     const std::size_t count = 3001;
@@ -336,7 +341,8 @@ TEST_P(OmsRoundTripAttributes, GeneratedCloudReadsBackBitExact) {
 }
 
 INSTANTIATE_TEST_SUITE_P(OmsEveryAttributeSet, OmsRoundTripAttributes,
-                         ::testing::Range<std::uint8_t>(0, 8),
+                         ::testing::Values<std::uint8_t>(0, 1, 2, 3, 4, 5, 6, 7, 0x08, 0x0e,
+                                                         0x1e, 0x3e, 0x3f),
                          [](const ::testing::TestParamInfo<std::uint8_t>& info) {
                              return "Bits" + std::to_string(info.param);
                          });
@@ -661,14 +667,20 @@ TEST(OmsReaderErrors, ResealedHeaderFieldsAreValidated) {
     const std::vector<HeaderEdit> edits = {
         {"sort depth", [](auto& b) { b[24] = 20; }, InputErrorKind::UnsupportedFeature, 24,
          "expected sort depth 21, found 20"},
-        {"unknown attribute", [](auto& b) { b[25] |= 0x08; }, InputErrorKind::UnsupportedFeature,
-         25, "expected attribute bits within 0x07 (normal 1, colour 2, intensity 4), found 0x0f"},
+        {"unknown attribute", [](auto& b) { b[25] |= 0x40; }, InputErrorKind::UnsupportedFeature,
+         25,
+         "expected attribute bits within 0x3f (normal 1, colour 2, intensity 4, LAS 8, GPS time "
+         "16, NIR 32), found 0x47"},
+        {"GPS time without LAS", [](auto& b) { b[25] |= 0x10; }, InputErrorKind::MalformedHeader,
+         25, "need the LAS bit"},
+        {"extra bytes without LAS", [](auto& b) { setField<std::uint16_t>(b, 28, 3); },
+         InputErrorKind::MalformedHeader, 25, "with 3 extra bytes"},
         {"record size", [](auto& b) { setField<std::uint16_t>(b, 26, 28); },
          InputErrorKind::MalformedHeader, 26, "expected a record size of 29 bytes"},
         {"attributes without record size", [](auto& b) { b[25] = 0; },
          InputErrorKind::MalformedHeader, 26, "expected a record size of 12 bytes"},
         {"reserved 0", [](auto& b) { b[30] = 1; }, InputErrorKind::MalformedHeader, 30,
-         "expected reserved header bytes 28-31 to be zero"},
+         "expected reserved header bytes 30-31 to be zero"},
         {"reserved 1", [](auto& b) { b[100] = 7; }, InputErrorKind::MalformedHeader, 100,
          "expected reserved header bytes 88-119 to be zero"},
         {"zero edge", [](auto& b) { setField(b, 56, 0.0); }, InputErrorKind::MalformedHeader, 56,

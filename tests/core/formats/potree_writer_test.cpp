@@ -89,7 +89,15 @@ void expectValidExport(const Hierarchy& hierarchy, const std::string& folder, in
     if (rgb && intensity) {
         EXPECT_LT(metadata.find(R"("name": "intensity")"), metadata.find(R"("name": "rgb")"));
     }
-    const std::size_t pointBytes = 12 + (rgb ? 6 : 0) + (intensity ? 2 : 0);
+    // The LAS fields: return number, number of returns, classification, scan angle (2), user
+    // data, point source id (2), and the GPS time (8) where the source has it.
+    const AttributeSet attributes = hierarchy.cloud().attributes();
+    const bool las = attributes.has(Attribute::Las);
+    EXPECT_EQ(metadata.find(R"("name": "classification")") != std::string::npos, las);
+    EXPECT_EQ(metadata.find(R"("name": "gps-time")") != std::string::npos,
+              attributes.has(Attribute::GpsTime));
+    const std::size_t pointBytes = 12 + (rgb ? 6 : 0) + (intensity ? 2 : 0) + (las ? 8 : 0) +
+                                   (attributes.has(Attribute::GpsTime) ? 8 : 0);
     const auto points = static_cast<std::uint64_t>(numberField(metadata, R"("points": (\d+))"));
     const auto firstChunk =
         static_cast<std::size_t>(numberField(metadata, R"("firstChunkSize": (\d+))"));

@@ -66,6 +66,9 @@ public:
         }
         m_info.cube = CubeTransform::fromBounds(m_info.sourceBounds);
         m_info.formatDetail = describeFormat();
+        if (options.onHierarchyPreview) {
+            offerHierarchyPreview(options);
+        }
     }
 
     ReadSummary read(const BatchConsumer& consumer, const ReadOptions& options) override;
@@ -94,6 +97,21 @@ private:
         }
         // A channel above 255 that the sample missed is clamped rather than wrapped.
         return {std::min(red, 255), std::min(green, 255), std::min(blue, 255)};
+    }
+
+    void offerHierarchyPreview(const OpenOptions& options) {
+        std::vector<glm::dvec3> positions;
+        std::vector<glm::u8vec3> colors;
+        const bool hasColor = m_colorDepth != ColorDepth::None;
+        m_records->hierarchyPreview(kPrePassSamplePoints, [&](const std::uint8_t* record) {
+            positions.push_back(sourcePosition(record));
+            if (hasColor) {
+                colors.push_back(color(record));
+            }
+        });
+        if (!positions.empty()) {
+            options.onHierarchyPreview(positions, colors);
+        }
     }
 
     // Only when the header's bounds are unusable (NaN, min > max): one pass over the records.

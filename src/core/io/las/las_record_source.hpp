@@ -32,6 +32,14 @@ public:
     using RecordVisitor = std::function<void(const std::uint8_t* record)>;
     virtual std::uint64_t sampleRecords(std::uint64_t maxRecords, const RecordVisitor& visit) = 0;
 
+    // A cloud with a level of detail of its own (COPC): visits the records of its top levels
+    // (at most about `maxRecords`, whole levels), a uniform sample of the whole cloud, and
+    // returns how many. 0 for other sources. Throws InputError.
+    virtual std::uint64_t hierarchyPreview(std::uint64_t /*maxRecords*/,
+                                           const RecordVisitor& /*visit*/) {
+        return 0;
+    }
+
     // Where record `index` is, for an error about it: the byte and how to name it.
     virtual InputLocation recordLocation(std::uint64_t index) const = 0;
     virtual std::string recordName(std::uint64_t index) const = 0;

@@ -2,10 +2,12 @@
 
 #include "io/laz/chunk_decoder.hpp"
 #include "io/laz/chunk_table.hpp"
+#include "io/laz/copc_hierarchy.hpp"
 #include "io/laz/laszip_vlr.hpp"
 
 #include <algorithm>
 #include <exception>
+#include <optional>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <vector>
@@ -27,6 +29,49 @@ public:
         const laz::PointDataExtent data{header.pointDataOffset, m_stream->size(), header.pointCount,
                                         header.recordLength};
         m_layout = laz::readChunkLayout(*m_stream, m_vlr, data);
+        m_copc = laz::readCopcInfo(*m_stream, header);
+    }
+
+    // COPC: the chunks of the hierarchy's top nodes, decoded whole (each node is one chunk).
+    std::uint64_t hierarchyPreview(std::uint64_t maxRecords, const RecordVisitor& visit) override {
+        if (!m_copc) {
+            return 0;
+        }
+        const std::vector<laz::CopcNode> nodes =
+            laz::readCopcTopNodes(*m_stream, *m_copc, maxRecords);
+        const std::vector<laz::Chunk>& chunks = m_layout.chunks;
+        std::uint64_t visited = 0;
+        std::vector<std::uint8_t> records;
+        for (const laz::CopcNode& node : nodes) {
+            const auto chunk = std::lower_bound(
+                chunks.begin(), chunks.end(), node.offset,
+                [](const laz::Chunk& c, std::uint64_t offset) { return c.offset < offset; });
+            if (chunk == chunks.end() || chunk->offset != node.offset ||
+                chunk->pointCount != node.pointCount) {
+                throw InputError(InputErrorKind::CorruptData, m_stream->path(),
+                                 InputLocation::byte(node.offset),
+                                 "COPC: the hierarchy's node " + std::to_string(node.level) +
+                                     "-" + std::to_string(node.x) + "-" + std::to_string(node.y) +
+                                     "-" + std::to_string(node.z) + " (" +
+                                     std::to_string(node.pointCount) + " points at byte " +
+                                     std::to_string(node.offset) +
+                                     ") is not a chunk of the chunk table");
+            }
+            const std::size_t c = static_cast<std::size_t>(chunk - chunks.begin());
+            if (decodedBytes(c) > m_streaming.batchBytes) {
+                continue;
+            }
+            const std::vector<std::uint8_t> bytes = readChunks(c, c + 1);
+            laz::ChunkDecoder decoder(m_vlr);
+            decoder.start(bytes, context(c));
+            records.resize(static_cast<std::size_t>(decodedBytes(c)));
+            decoder.decode(records.data(), chunk->pointCount);
+            for (std::uint64_t i = 0; i < chunk->pointCount; ++i) {
+                visit(records.data() + i * m_header.recordLength);
+            }
+            visited += chunk->pointCount;
+        }
+        return visited;
     }
 
     void forEachBlock(const BlockVisitor& visit) override {
@@ -100,9 +145,9 @@ public:
         if (m_vlr.compressor == laz::Compressor::Pointwise) {
             return text;
         }
-        return text + (m_vlr.variableChunks()
-                           ? " of variable size"
-                           : " of " + std::to_string(m_vlr.chunkSize) + " points");
+        text += m_vlr.variableChunks() ? " of variable size"
+                                       : " of " + std::to_string(m_vlr.chunkSize) + " points";
+        return m_copc ? text + ", COPC hierarchy" : text;
     }
 
 private:
@@ -214,6 +259,7 @@ private:
     LazStreaming m_streaming;
     laz::LaszipVlr m_vlr;
     laz::ChunkLayout m_layout;
+    std::optional<laz::CopcInfo> m_copc; // a COPC file's info record
 };
 
 } // namespace

@@ -127,7 +127,8 @@ TEST(LasAutzenTest, HeaderDescribesTheSurvey) {
     EXPECT_EQ(info.format, CloudFormat::Las);
     EXPECT_EQ(info.pointCount, 110000u);
     EXPECT_TRUE(info.boundsFromHeader);
-    EXPECT_EQ(info.attributes, AttributeSet(Attribute::Intensity) | Attribute::Color);
+    EXPECT_EQ(info.attributes, AttributeSet(Attribute::Intensity) | Attribute::Color |
+                                   Attribute::Las | Attribute::GpsTime);
     EXPECT_EQ(info.sourceOffset, glm::dvec3(0.0));
     EXPECT_EQ(info.formatDetail.rfind("LAS 1.2, point format 3, 34-byte records, 8-bit colour "
                                       "in 16-bit fields",

@@ -1,0 +1,207 @@
+// Every LAS attribute end to end: the LAS column read from LAS and LAZ records of the legacy
+// and the LAS 1.4 layouts, carried through the real sorter, a .oms stream and a LAS 1.4
+// export byte for byte, and the same from a LAZ file as from its uncompressed twin.
+#include "formats/oms_reader.hpp"
+#include "formats/oms_writer.hpp"
+#include "io/cloud_export.hpp"
+#include "io/las/las_header.hpp"
+#include "io/las/las_point_fields.hpp"
+#include "io/point_reader.hpp"
+#include "points/attribute_statistics.hpp"
+#include "sort/morton_sorter.hpp"
+#include "test_files.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <gtest/gtest.h>
+#include <string>
+#include <tuple>
+#include <vector>
+
+namespace omicron {
+namespace {
+
+// One point as (position bits, LAS column bytes): the sorter permutes points, so clouds are
+// compared as sorted lists of these.
+using PointKey = std::tuple<std::array<std::uint32_t, 3>, std::vector<std::uint8_t>>;
+
+PointKey keyOf(const glm::vec3& position, const std::uint8_t* las, std::size_t lasBytes) {
+    std::array<std::uint32_t, 3> bits;
+    std::memcpy(bits.data(), &position, sizeof position);
+    return {bits, std::vector<std::uint8_t>(las, las + lasBytes)};
+}
+
+std::vector<PointKey> keysOf(const PointBatch& batch) {
+    std::vector<PointKey> keys;
+    const std::size_t lasBytes = batch.attributes.lasBytes();
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+        keys.push_back(keyOf(batch.positions[i], batch.las.data() + i * lasBytes, lasBytes));
+    }
+    std::sort(keys.begin(), keys.end());
+    return keys;
+}
+
+std::shared_ptr<const SortedCloud> sortFile(const std::string& path) {
+    auto reader = openPointCloud(path);
+    std::shared_ptr<const SortedCloud> cloud;
+    sortPointCloud(*reader, SortOptions{}, [](const SortedCloud&, std::size_t, std::size_t) {},
+                   [&](const IncrementalMortonSorter& sorter) { cloud = sorter.cloud(); });
+    EXPECT_TRUE(cloud && cloud->complete());
+    return cloud;
+}
+
+TEST(LasFields, LegacyRecordFieldsSurviveLas14AndBack) {
+    // Point format 1: return 2 of 3, scan direction and edge set; class 6 (building),
+    // synthetic and withheld; scan angle rank -15 degrees; user data 7; source 1234; GPS time.
+    std::array<std::uint8_t, 28> legacy{};
+    legacy[14] = 2 | 3 << 3 | 0x40 | 0x80;
+    legacy[15] = 6 | 0x20 | 0x80;
+    legacy[16] = static_cast<std::uint8_t>(std::int8_t{-15});
+    legacy[17] = 7;
+    const std::uint16_t source = 1234;
+    std::memcpy(&legacy[18], &source, 2);
+    const double gps = 123456.789;
+    std::memcpy(&legacy[20], &gps, 8);
+
+    const LasFields fields = las::readLasFields(legacy.data(), 1);
+    EXPECT_EQ(fields.classification, 6);
+    EXPECT_EQ(fields.returnNumber(), 2);
+    EXPECT_EQ(fields.numberOfReturns(), 3);
+    EXPECT_EQ(fields.flags, las_flag::kSynthetic | las_flag::kWithheld |
+                                las_flag::kScanDirection | las_flag::kEdgeOfFlightLine);
+    EXPECT_NEAR(fields.scanAngleDegrees(), -15.0, 0.003);
+    EXPECT_EQ(fields.userData, 7);
+    EXPECT_EQ(fields.pointSourceId, 1234);
+    EXPECT_EQ(fields.gpsTime, gps);
+
+    std::array<std::uint8_t, 30> v14{};
+    las::writeLasFields(fields, 6, v14.data());
+    const LasFields again = las::readLasFields(v14.data(), 6);
+    EXPECT_EQ(std::memcmp(&again, &fields, sizeof fields), 0);
+
+    std::array<std::uint8_t, 28> back{};
+    las::writeLasFields(again, 1, back.data());
+    EXPECT_TRUE(std::equal(legacy.begin() + 14, legacy.end(), back.begin() + 14))
+        << "the legacy fields did not read back as written";
+}
+
+TEST(LasFields, AttributesOfEveryFormat) {
+    for (std::uint8_t format = 0; format <= 10; ++format) {
+        SCOPED_TRACE(static_cast<int>(format));
+        const AttributeSet a = las::attributesOfFormat(format, 100);
+        EXPECT_TRUE(a.has(Attribute::Las));
+        EXPECT_TRUE(a.has(Attribute::Intensity));
+        EXPECT_EQ(a.has(Attribute::GpsTime), format != 0 && format != 2);
+        EXPECT_EQ(a.has(Attribute::Nir), format == 8 || format == 10);
+        EXPECT_EQ(a.extraBytes(), 100 - las::minimumRecordLength(format));
+    }
+}
+
+class LasAttributesEndToEnd : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(LasAttributesEndToEnd, SortOmsAndLasExportKeepEveryFieldByteForByte) {
+    OMICRON_REQUIRE_SHARED_FILE(path, GetParam());
+    test::TempDir dir;
+    const LoadedCloud original = loadPointCloud(path);
+    const AttributeSet attributes = original.info.attributes;
+    ASSERT_TRUE(attributes.has(Attribute::Las));
+    ASSERT_TRUE(original.points.consistent());
+
+    // The sorter permutes every field with its point.
+    const auto sorted = sortFile(path);
+    ASSERT_EQ(sorted->attributes(), attributes);
+    PointBatch sortedPoints;
+    sorted->copyRange(0, sorted->sortedEnd(), sortedPoints);
+    ASSERT_TRUE(keysOf(sortedPoints) == keysOf(original.points))
+        << "the sorted cloud's (position, LAS fields) pairs differ from the file's";
+
+    // .oms stores the column as it is.
+    const std::string oms = dir.file("sorted.oms");
+    OmsWriter writer;
+    writer.open(oms, sorted->cube(), sorted->sourceOffset(), attributes, sorted->sortedEnd());
+    writer.append(*sorted, 0, sorted->sortedEnd());
+    writer.finish();
+    OmsReader reader(oms);
+    reader.read([](const SortedCloud&, std::size_t, std::size_t) {});
+    ASSERT_EQ(reader.cloud()->attributes(), attributes);
+    EXPECT_TRUE(std::ranges::equal(reader.cloud()->lasColumn(), sorted->lasColumn()));
+
+    // A LAS export writes LAS 1.4 with every field and extra byte; read back in the same order.
+    const std::string las = dir.file("export.las");
+    ASSERT_EQ(exportCloudPoints(las, *sorted), sorted->sortedEnd());
+    const LoadedCloud exported = loadPointCloud(las);
+    EXPECT_NE(exported.info.formatDetail.find("LAS 1.4"), std::string::npos)
+        << exported.info.formatDetail;
+    ASSERT_EQ(exported.info.attributes.extraBytes(), attributes.extraBytes());
+    EXPECT_EQ(exported.info.attributes.has(Attribute::Nir), attributes.has(Attribute::Nir));
+    ASSERT_EQ(exported.points.size(), sorted->sortedEnd());
+    // A format without GPS time (0, 2) exports its zero GPS time: compare the common fields.
+    const std::size_t n = exported.points.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        const LasFields want = decodeLasFields(attributes, sorted->lasRecord(i));
+        const LasFields got = decodeLasFields(exported.points.attributes,
+                                              exported.points.las.data() +
+                                                  i * exported.points.attributes.lasBytes());
+        ASSERT_EQ(std::memcmp(&got, &want, sizeof got), 0) << "point " << i;
+        const LasColumnLayout from = LasColumnLayout::of(attributes);
+        const LasColumnLayout to = LasColumnLayout::of(exported.points.attributes);
+        ASSERT_EQ(std::memcmp(sorted->lasRecord(i) + from.extraOffset,
+                              exported.points.las.data() + i * to.bytes + to.extraOffset,
+                              from.extraBytes),
+                  0)
+            << "the extra bytes of point " << i;
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(SharedData, LasAttributesEndToEnd,
+                         ::testing::Values("autzen_trim.las", "laz/terrascan_fmt8.laz",
+                                           "laz/1.2-with-color.copc.laz"),
+                         test::FileParamName());
+
+TEST(LasAttributes, LazColumnEqualsItsUncompressedTwin) {
+    OMICRON_REQUIRE_SHARED_FILE(laz, "laz/terrascan_fmt8.laz");
+    OMICRON_REQUIRE_SHARED_FILE(las, "laz/terrascan_fmt8.las");
+    const LoadedCloud a = loadPointCloud(laz);
+    const LoadedCloud b = loadPointCloud(las);
+    ASSERT_EQ(a.info.attributes, b.info.attributes);
+    EXPECT_EQ(a.info.attributes.extraBytes(), 3);
+    EXPECT_TRUE(a.info.attributes.has(Attribute::Nir));
+    EXPECT_TRUE(a.points.las == b.points.las);
+}
+
+TEST(LasAttributes, StatisticsCountTheClassesOfTheFile) {
+    OMICRON_REQUIRE_SHARED_FILE(path, "laz/terrascan_fmt8.laz");
+    OMICRON_REQUIRE_SHARED_FILE(reference, "laz/terrascan_fmt8.las");
+    const LoadedCloud cloud = loadPointCloud(path);
+    AttributeStatistics statistics;
+    statistics.add(cloud.points);
+    const auto& counts = statistics.classCounts();
+    // Counted independently from the uncompressed twin's raw records (decoded by another LAZ
+    // implementation): the class byte at offset 16 of a format 8 record.
+    const std::vector<std::uint8_t> bytes = test::readBytes(reference);
+    std::uint32_t dataOffset;
+    std::uint16_t recordLength;
+    std::uint64_t count;
+    std::memcpy(&dataOffset, &bytes.at(96), 4);
+    std::memcpy(&recordLength, &bytes.at(105), 2);
+    std::memcpy(&count, &bytes.at(247), 8);
+    std::array<std::uint64_t, 256> expected{};
+    for (std::uint64_t i = 0; i < count; ++i) {
+        ++expected[bytes.at(dataOffset + i * recordLength + 16)];
+    }
+    EXPECT_TRUE(std::equal(counts.begin(), counts.end(), expected.begin()));
+    EXPECT_EQ(statistics.points(), count);
+    EXPECT_EQ(lasClassName(2), "Ground");
+    bool gps = false;
+    for (const NamedRange& range : statistics.ranges()) {
+        if (range.name == "gps time") {
+            gps = true;
+            EXPECT_LT(range.range.min, range.range.max);
+        }
+    }
+    EXPECT_TRUE(gps);
+}
+
+} // namespace
+} // namespace omicron
