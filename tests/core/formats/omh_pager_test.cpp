@@ -85,6 +85,9 @@ void expectFrontPointsEqual(const Front& front, const Hierarchy& paged, const Hi
             if (a.attributes().has(Attribute::Color)) {
                 ASSERT_EQ(a.colors()[i], b.colors()[i]);
             }
+            const std::size_t lasBytes = a.attributes().lasBytes();
+            ASSERT_EQ(std::memcmp(a.lasRecord(i), b.lasRecord(i), lasBytes), 0)
+                << "the LAS fields of level " << level << " node " << entry.index << " point " << p;
         }
         paged.nodeSplats(node, pagedSplats, scratch);
         whole.nodeSplats(whole.node(level, entry.index), wholeSplats, scratch);
@@ -159,6 +162,23 @@ TEST(OmhPagedLoad, NodesOnlyAtOpenThenEveryLeafOnDemandEqualToTheWholeLoad) {
     }
     EXPECT_EQ(stats.heldBytes, frontPoints * OmhPager::residentBytesPerPoint(reader.header()));
     EXPECT_GT(stats.loads, leafCount(*paged)) << "the front passed through the inner levels";
+}
+
+TEST(OmhPagedLoad, ALasScanPagesItsLasFieldsWithItsPoints) {
+    OMICRON_REQUIRE_SHARED_FILE(las, "laz/terrascan_fmt8.laz");
+    TempDir dir;
+    const BuildResult built = buildFile(las, checkedOptions(5, LeafCollapse::Off));
+    const std::string path = dir.file("paged.omh");
+    writeOmh(path, built.builder->hierarchy(),
+             omhBuildInfo(built.builder->options(), built.builder->statistics()));
+    const auto whole = loadWhole(path);
+    ASSERT_EQ(whole->cloud().attributes().extraBytes(), 3);
+    OmhReader reader(path);
+    const auto paged = openPaged(reader, std::uint64_t{1} << 30);
+    Front front(paged);
+    settlePaged(front, lookingAt({0.5, 0.5, 0.5}, 0.5, 1e9), fullDetail());
+    EXPECT_EQ(front.entries().size(), leafCount(*paged));
+    expectFrontPointsEqual(front, *paged, *whole);
 }
 
 TEST(OmhPagedLoad, ATinyBudgetEvictsAndReloadsAndNeverDrawsAMissingNode) {

@@ -63,6 +63,7 @@ void expectSamePoints(const PointBatch& a, const PointBatch& b) {
         differences += same ? 0 : 1;
     }
     EXPECT_EQ(differences, 0u);
+    EXPECT_TRUE(a.las == b.las) << "the LAS fields were not carried through the runs";
 }
 
 std::size_t entriesIn(const std::filesystem::path& folder) {
@@ -138,7 +139,8 @@ TEST_P(ExternalSort, RunsOnDiskGiveThePointsOfTheInMemorySort) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Files, ExternalSort,
-                         testing::Values("autzen_trim.las", "lion.ply", "dragon.ply", "indoor.ply"),
+                         testing::Values("autzen_trim.las", "laz/terrascan_fmt8.laz", "lion.ply",
+                                         "dragon.ply", "indoor.ply"),
                          test::FileParamName{});
 
 TEST(ExternalSortAdversarial, EqualCodesAcrossRunsKeepTheirInputOrder) {
