@@ -3,6 +3,7 @@
 #include "formats/omh_pager.hpp"
 #include "formats/omh_record_decoder.hpp"
 #include "io/input_error.hpp"
+#include "io/raw_bytes.hpp"
 
 #include <algorithm>
 #include <array>
@@ -22,12 +23,6 @@ namespace {
 // Point records are read and decoded in blocks of about this size.
 constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
 
-template <typename T> T loadLe(const std::uint8_t* at) {
-    T value;
-    std::memcpy(&value, at, sizeof(T));
-    return value;
-}
-
 std::string hex(std::uint64_t value) {
     char text[19];
     std::snprintf(text, sizeof(text), "0x%016llx", static_cast<unsigned long long>(value));
@@ -39,7 +34,7 @@ bool isFinite(const glm::dvec3& v) {
 }
 
 glm::dvec3 loadDvec3(const std::uint8_t* at) {
-    return {loadLe<double>(at), loadLe<double>(at + 8), loadLe<double>(at + 16)};
+    return {loadRaw<double>(at), loadRaw<double>(at + 8), loadRaw<double>(at + 16)};
 }
 
 std::string range(std::uint64_t begin, std::uint64_t end) {
@@ -122,7 +117,7 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
                     "the file ends inside the header (" + range(0, omh::kHeaderBytes) +
                         "), expected " + std::to_string(omh::kHeaderBytes) + " header bytes");
     }
-    const auto endianness = loadLe<std::uint32_t>(header.data() + h::kEndianness);
+    const auto endianness = loadRaw<std::uint32_t>(header.data() + h::kEndianness);
     if (endianness == __builtin_bswap32(omh::kEndiannessMarker)) {
         throw error(InputErrorKind::UnsupportedFeature, h::kEndianness,
                     "in the header: the file was written in big-endian byte order; only "
@@ -132,13 +127,13 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
         throw error(InputErrorKind::MalformedHeader, h::kEndianness,
                     "in the header: expected the endianness marker bytes 04 03 02 01");
     }
-    const auto version = loadLe<std::uint32_t>(header.data() + h::kVersion);
+    const auto version = loadRaw<std::uint32_t>(header.data() + h::kVersion);
     if (version != omh::kVersion) {
         throw error(InputErrorKind::UnsupportedFeature, h::kVersion,
                     "in the header: expected .omh format version " + std::to_string(omh::kVersion) +
                         ", found " + std::to_string(version));
     }
-    const auto storedChecksum = loadLe<std::uint64_t>(header.data() + h::kChecksum);
+    const auto storedChecksum = loadRaw<std::uint64_t>(header.data() + h::kChecksum);
     const std::uint64_t headerChecksum = omh::smallChecksum(header.data(), h::kChecksum);
     if (storedChecksum != headerChecksum) {
         throw error(InputErrorKind::MalformedHeader, h::kChecksum,
@@ -156,11 +151,11 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     info.path = path;
     info.version = version;
     info.fileBytes = fileBytes;
-    info.totalNodes = loadLe<std::uint64_t>(header.data() + h::kTotalNodes);
-    info.totalPoints = loadLe<std::uint64_t>(header.data() + h::kTotalPoints);
-    info.build.inputPoints = loadLe<std::uint64_t>(header.data() + h::kInputPoints);
-    info.build.droppedPoints = loadLe<std::uint64_t>(header.data() + h::kDroppedPoints);
-    info.build.collapsedLeaves = loadLe<std::uint64_t>(header.data() + h::kCollapsedLeaves);
+    info.totalNodes = loadRaw<std::uint64_t>(header.data() + h::kTotalNodes);
+    info.totalPoints = loadRaw<std::uint64_t>(header.data() + h::kTotalPoints);
+    info.build.inputPoints = loadRaw<std::uint64_t>(header.data() + h::kInputPoints);
+    info.build.droppedPoints = loadRaw<std::uint64_t>(header.data() + h::kDroppedPoints);
+    info.build.collapsedLeaves = loadRaw<std::uint64_t>(header.data() + h::kCollapsedLeaves);
     const int maxLevel = header[h::kMaxLevel];
     if (maxLevel < 1 || maxLevel > morton::kMaxLevel) {
         throw malformed(h::kMaxLevel,
@@ -189,7 +184,7 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
         throw malformed(h::kAttributes, "unknown attribute bits");
     }
     info.attributes =
-        AttributeSet::fromBits(attributeBits, loadLe<std::uint16_t>(header.data() + h::kExtraBytes));
+        AttributeSet::fromBits(attributeBits, loadRaw<std::uint16_t>(header.data() + h::kExtraBytes));
     if (!info.attributes.valid()) {
         throw malformed(h::kExtraBytes, "GPS time, NIR and extra bytes need the LAS attribute bit");
     }
@@ -203,7 +198,7 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     }
     info.estimatedNormals = expectedEstimate;
     m_layout = omh::RecordLayout::of(info.attributes, info.estimatedNormals);
-    info.recordBytes = loadLe<std::uint16_t>(header.data() + h::kRecordBytes);
+    info.recordBytes = loadRaw<std::uint16_t>(header.data() + h::kRecordBytes);
     if (info.recordBytes != m_layout.bytes) {
         throw malformed(h::kRecordBytes, "expected a record size of " +
                                              std::to_string(m_layout.bytes) + " bytes, found " +
@@ -220,12 +215,12 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
                                     std::to_string(h::kChecksum - 1) + " to be zero");
         }
     }
-    info.build.ratio = loadLe<double>(header.data() + h::kRatio);
+    info.build.ratio = loadRaw<double>(header.data() + h::kRatio);
     if (!(info.build.ratio > 0.0 && info.build.ratio <= 1.0)) {
         throw malformed(h::kRatio, "expected a ratio in (0, 1]");
     }
     info.cube = CubeTransform{loadDvec3(header.data() + h::kCubeOrigin),
-                              loadLe<double>(header.data() + h::kCubeEdge)};
+                              loadRaw<double>(header.data() + h::kCubeEdge)};
     info.sourceOffset = loadDvec3(header.data() + h::kSourceOffset);
     if (!isFinite(info.cube.origin) || !isFinite(info.sourceOffset)) {
         throw malformed(h::kCubeOrigin, "expected a finite cube origin and source offset");
@@ -248,7 +243,7 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     std::vector<std::uint8_t> table(tableBytes);
     m_stream.readExact(table.data(), table.size(), "the level table");
     const std::uint64_t entryBytes = levelCount * omh::kLevelEntryBytes;
-    const auto storedTableChecksum = loadLe<std::uint64_t>(table.data() + entryBytes);
+    const auto storedTableChecksum = loadRaw<std::uint64_t>(table.data() + entryBytes);
     const std::uint64_t tableChecksum = omh::smallChecksum(table.data(), entryBytes);
     if (storedTableChecksum != tableChecksum) {
         throw error(InputErrorKind::MalformedHeader, omh::kHeaderBytes + entryBytes,
@@ -261,13 +256,13 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     for (std::size_t l = 0; l < levelCount; ++l) {
         const std::uint8_t* at = table.data() + l * omh::kLevelEntryBytes;
         omh::LevelEntry& e = info.levels[l];
-        e.nodes = loadLe<std::uint64_t>(at + omh::level::kNodes);
-        e.leaves = loadLe<std::uint64_t>(at + omh::level::kLeaves);
-        e.points = loadLe<std::uint64_t>(at + omh::level::kPoints);
-        e.nodeTableOffset = loadLe<std::uint64_t>(at + omh::level::kNodeTableOffset);
-        e.payloadOffset = loadLe<std::uint64_t>(at + omh::level::kPayloadOffset);
-        e.nodeChecksum = loadLe<std::uint64_t>(at + omh::level::kNodeChecksum);
-        e.payloadChecksum = loadLe<std::uint64_t>(at + omh::level::kPayloadChecksum);
+        e.nodes = loadRaw<std::uint64_t>(at + omh::level::kNodes);
+        e.leaves = loadRaw<std::uint64_t>(at + omh::level::kLeaves);
+        e.points = loadRaw<std::uint64_t>(at + omh::level::kPoints);
+        e.nodeTableOffset = loadRaw<std::uint64_t>(at + omh::level::kNodeTableOffset);
+        e.payloadOffset = loadRaw<std::uint64_t>(at + omh::level::kPayloadOffset);
+        e.nodeChecksum = loadRaw<std::uint64_t>(at + omh::level::kNodeChecksum);
+        e.payloadChecksum = loadRaw<std::uint64_t>(at + omh::level::kPayloadChecksum);
         const std::uint64_t byte = omh::kHeaderBytes + l * omh::kLevelEntryBytes;
         const auto bad = [&](const std::string& detail) {
             return error(InputErrorKind::MalformedHeader, byte,
@@ -336,13 +331,13 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
         throw error(InputErrorKind::MalformedValue, footerStart,
                     "in the footer: expected the footer magic 'OMHEND\\x00\\x00'");
     }
-    const auto storedFooterChecksum = loadLe<std::uint64_t>(footer.data() + omh::footer::kChecksum);
+    const auto storedFooterChecksum = loadRaw<std::uint64_t>(footer.data() + omh::footer::kChecksum);
     if (storedFooterChecksum != omh::smallChecksum(footer.data(), omh::footer::kChecksum)) {
         throw error(InputErrorKind::MalformedValue, footerStart + omh::footer::kChecksum,
                     "footer checksum mismatch: the footer is damaged");
     }
-    if (loadLe<std::uint64_t>(footer.data() + omh::footer::kTotalNodes) != info.totalNodes ||
-        loadLe<std::uint64_t>(footer.data() + omh::footer::kTotalPoints) != info.totalPoints) {
+    if (loadRaw<std::uint64_t>(footer.data() + omh::footer::kTotalNodes) != info.totalNodes ||
+        loadRaw<std::uint64_t>(footer.data() + omh::footer::kTotalPoints) != info.totalPoints) {
         throw error(InputErrorKind::CountMismatch, footerStart + omh::footer::kTotalNodes,
                     "the footer's node and point counts differ from the header's");
     }
@@ -426,24 +421,24 @@ std::vector<OctreeNode> OmhReader::readNodes(int level, std::vector<std::uint8_t
                               "in " + section + ", node " + std::to_string(i) + ": " + detail);
         };
         OctreeNode& node = nodes[i];
-        node.code = loadLe<std::uint64_t>(record + omh::node::kCode);
+        node.code = loadRaw<std::uint64_t>(record + omh::node::kCode);
         if (node.code != expectedCodes[i]) {
             throw bad(omh::node::kCode, "expected code " + hex(expectedCodes[i]) +
                                             " (announced by its parent's child mask), found " +
                                             hex(node.code));
         }
-        const auto first = loadLe<std::uint64_t>(record + omh::node::kFirstPoint);
+        const auto first = loadRaw<std::uint64_t>(record + omh::node::kFirstPoint);
         if (first != firstPoint + points) {
             throw bad(omh::node::kFirstPoint, "expected its points to start at record " +
                                                   std::to_string(firstPoint + points));
         }
-        const auto count = loadLe<std::uint64_t>(record + omh::node::kPointCount);
+        const auto count = loadRaw<std::uint64_t>(record + omh::node::kPointCount);
         if (count == 0 || count > entry.points - points) {
             throw bad(omh::node::kPointCount, "expected 1 to " +
                                                   std::to_string(entry.points - points) +
                                                   " points, found " + std::to_string(count));
         }
-        node.splatScale = loadLe<float>(record + omh::node::kSplatScale);
+        node.splatScale = loadRaw<float>(record + omh::node::kSplatScale);
         if (!std::isfinite(node.splatScale) || !(node.splatScale > 0.0f)) {
             throw bad(omh::node::kSplatScale, "expected a finite splat scale > 0");
         }
@@ -457,7 +452,7 @@ std::vector<OctreeNode> OmhReader::readNodes(int level, std::vector<std::uint8_t
                                              " and child mask " + std::to_string(mask) +
                                              " contradict each other or the level");
         }
-        if (loadLe<std::uint16_t>(record + omh::node::kReserved) != 0) {
+        if (loadRaw<std::uint16_t>(record + omh::node::kReserved) != 0) {
             throw bad(omh::node::kReserved, "expected reserved zero bytes");
         }
         node.sampleIndices = nullptr;

@@ -1,22 +1,13 @@
 #include "formats/omh_record_decoder.hpp"
 
 #include "formats/omh_reader.hpp"
+#include "io/raw_bytes.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 
 namespace omicron {
-
-namespace {
-
-template <typename T> T loadLe(const std::uint8_t* at) {
-    T value;
-    std::memcpy(&value, at, sizeof(T));
-    return value;
-}
-
-} // namespace
 
 OmhRecordDecoder::OmhRecordDecoder(const omh::Header& header, SortedCloud& cloud,
                                    StoredSplats& splats)
@@ -31,7 +22,7 @@ std::size_t OmhRecordDecoder::store(const std::uint8_t* records, std::size_t cou
     const std::uint8_t* record = records;
     for (std::size_t r = 0; r < count; ++r, record += m_layout.bytes) {
         const std::size_t at = point + r;
-        const auto p = loadLe<glm::vec3>(record);
+        const auto p = loadRaw<glm::vec3>(record);
         const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
         if ((!finite || (morton::encodeUnit(p.x, p.y, p.z) >> shift) != nodeCode) &&
             firstBad == count) {
@@ -39,20 +30,20 @@ std::size_t OmhRecordDecoder::store(const std::uint8_t* records, std::size_t cou
         }
         m_cloud.mutablePositions()[at] = p;
         if (m_attributes.has(Attribute::Normal)) {
-            m_cloud.mutableNormals()[at] = loadLe<glm::vec3>(record + m_layout.point.normalOffset);
+            m_cloud.mutableNormals()[at] = loadRaw<glm::vec3>(record + m_layout.point.normalOffset);
         }
         if (m_attributes.has(Attribute::Color)) {
-            m_cloud.mutableColors()[at] = loadLe<glm::u8vec3>(record + m_layout.point.colorOffset);
+            m_cloud.mutableColors()[at] = loadRaw<glm::u8vec3>(record + m_layout.point.colorOffset);
         }
         if (m_attributes.has(Attribute::Intensity)) {
             m_cloud.mutableIntensities()[at] =
-                loadLe<std::uint16_t>(record + m_layout.point.intensityOffset);
+                loadRaw<std::uint16_t>(record + m_layout.point.intensityOffset);
         }
         std::memcpy(m_cloud.mutableLasColumn().data() + at * m_layout.point.lasBytes,
                     record + m_layout.point.lasOffset, m_layout.point.lasBytes);
-        m_splats.setEncoded(at, loadLe<std::uint16_t>(record + m_layout.radiusOffset),
+        m_splats.setEncoded(at, loadRaw<std::uint16_t>(record + m_layout.radiusOffset),
                             m_estimatedNormals
-                                ? loadLe<std::uint32_t>(record + m_layout.estimatedNormalOffset)
+                                ? loadRaw<std::uint32_t>(record + m_layout.estimatedNormalOffset)
                                 : 0u);
     }
     return firstBad;

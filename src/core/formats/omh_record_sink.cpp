@@ -1,5 +1,7 @@
 #include "formats/omh_record_sink.hpp"
 
+#include "io/raw_bytes.hpp"
+
 #include <algorithm>
 #include <cstring>
 
@@ -12,10 +14,6 @@ constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
 // A positional sink starts the write-back of each window it completes and drops the window
 // before it from the page cache (the sequential writer's drop-behind, per region).
 constexpr std::uint64_t kCacheWindowBytes = std::uint64_t{64} << 20;
-
-template <typename T> void store(std::uint8_t* at, const T& value) {
-    std::memcpy(at, &value, sizeof(T));
-}
 
 } // namespace
 
@@ -39,21 +37,21 @@ void OmhRecordSink::add(std::uint32_t index, std::uint16_t encodedRadius,
     }
     std::uint8_t* record = m_block.data() + m_used;
     const AttributeSet attributes = m_cloud.attributes();
-    store(record, m_cloud.position(index));
+    storeRaw(record, m_cloud.position(index));
     if (attributes.has(Attribute::Normal)) {
-        store(record + m_layout.point.normalOffset, m_cloud.normals()[index]);
+        storeRaw(record + m_layout.point.normalOffset, m_cloud.normals()[index]);
     }
     if (attributes.has(Attribute::Color)) {
-        store(record + m_layout.point.colorOffset, m_cloud.color(index));
+        storeRaw(record + m_layout.point.colorOffset, m_cloud.color(index));
     }
     if (attributes.has(Attribute::Intensity)) {
-        store(record + m_layout.point.intensityOffset, m_cloud.intensities()[index]);
+        storeRaw(record + m_layout.point.intensityOffset, m_cloud.intensities()[index]);
     }
     std::memcpy(record + m_layout.point.lasOffset, m_cloud.lasRecord(index),
                 m_layout.point.lasBytes);
-    store(record + m_layout.radiusOffset, encodedRadius);
+    storeRaw(record + m_layout.radiusOffset, encodedRadius);
     if (m_layout.estimatedNormalOffset != 0) {
-        store(record + m_layout.estimatedNormalOffset, estimatedNormal);
+        storeRaw(record + m_layout.estimatedNormalOffset, estimatedNormal);
     }
     m_used += m_layout.bytes;
 }

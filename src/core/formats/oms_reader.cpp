@@ -1,6 +1,7 @@
 #include "formats/oms_reader.hpp"
 
 #include "io/input_error.hpp"
+#include "io/raw_bytes.hpp"
 #include "sort/budgeted_cloud.hpp"
 
 #include <algorithm>
@@ -18,12 +19,6 @@ namespace {
 
 // Records are read and decoded in blocks of at most this size (and at most one range).
 constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
-
-template <typename T> T load(const std::uint8_t* at) {
-    T value;
-    std::memcpy(&value, at, sizeof(T));
-    return value;
-}
 
 // `digits` hex digits: 16 for checksums and codes, fewer for small fields.
 std::string hex(std::uint64_t value, int digits = 16) {
@@ -56,7 +51,7 @@ bool isFinite(const glm::dvec3& v) {
 }
 
 glm::dvec3 loadDvec3(const std::uint8_t* at) {
-    return {load<double>(at), load<double>(at + 8), load<double>(at + 16)};
+    return {loadRaw<double>(at), loadRaw<double>(at + 8), loadRaw<double>(at + 16)};
 }
 
 std::string lowerExtension(const std::string& path) {
@@ -108,7 +103,7 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage,
                         std::to_string(fileBytes));
     }
 
-    const auto endianness = load<std::uint32_t>(header.data() + h::kEndianness);
+    const auto endianness = loadRaw<std::uint32_t>(header.data() + h::kEndianness);
     if (endianness == __builtin_bswap32(oms::kEndiannessMarker)) {
         throw error(InputErrorKind::UnsupportedFeature, h::kEndianness,
                     "the file was written in big-endian byte order (marker bytes 01 02 03 04); "
@@ -119,13 +114,13 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage,
                     "expected the endianness marker " + hex(oms::kEndiannessMarker, 8) +
                         ", found " + hex(endianness, 8));
     }
-    const auto version = load<std::uint32_t>(header.data() + h::kVersion);
+    const auto version = loadRaw<std::uint32_t>(header.data() + h::kVersion);
     if (version != oms::kVersion) {
         throw error(InputErrorKind::UnsupportedFeature, h::kVersion,
                     "expected .oms format version " + std::to_string(oms::kVersion) +
                         ", found version " + std::to_string(version));
     }
-    const auto storedHeaderChecksum = load<std::uint64_t>(header.data() + h::kChecksum);
+    const auto storedHeaderChecksum = loadRaw<std::uint64_t>(header.data() + h::kChecksum);
     const std::uint64_t headerChecksum = oms::headerChecksum(header.data());
     if (storedHeaderChecksum != headerChecksum) {
         throw error(InputErrorKind::MalformedHeader, h::kChecksum,
@@ -135,13 +130,13 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage,
                         ": the header is damaged");
     }
 
-    const auto sortDepth = load<std::uint8_t>(header.data() + h::kSortDepth);
+    const auto sortDepth = loadRaw<std::uint8_t>(header.data() + h::kSortDepth);
     if (sortDepth != oms::kSortDepth) {
         throw error(InputErrorKind::UnsupportedFeature, h::kSortDepth,
                     "expected sort depth " + std::to_string(oms::kSortDepth) + ", found " +
                         std::to_string(sortDepth));
     }
-    const auto attributeBits = load<std::uint8_t>(header.data() + h::kAttributes);
+    const auto attributeBits = loadRaw<std::uint8_t>(header.data() + h::kAttributes);
     if ((attributeBits & ~oms::kKnownAttributeBits) != 0) {
         throw error(InputErrorKind::UnsupportedFeature, h::kAttributes,
                     "expected attribute bits within " + hex(oms::kKnownAttributeBits, 2) +
@@ -149,7 +144,7 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage,
                         "found " +
                         hex(attributeBits, 2));
     }
-    const auto extraBytes = load<std::uint16_t>(header.data() + h::kExtraBytes);
+    const auto extraBytes = loadRaw<std::uint16_t>(header.data() + h::kExtraBytes);
     const AttributeSet attributes = AttributeSet::fromBits(attributeBits, extraBytes);
     if (!attributes.valid()) {
         throw error(InputErrorKind::MalformedHeader, h::kAttributes,
@@ -158,7 +153,7 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage,
                         " extra bytes: GPS time, NIR and extra bytes need the LAS bit (8)");
     }
     m_layout = oms::RecordLayout::of(attributes);
-    const auto recordBytes = load<std::uint16_t>(header.data() + h::kRecordBytes);
+    const auto recordBytes = loadRaw<std::uint16_t>(header.data() + h::kRecordBytes);
     if (recordBytes != m_layout.bytes) {
         throw error(InputErrorKind::MalformedHeader, h::kRecordBytes,
                     "expected a record size of " + std::to_string(m_layout.bytes) +
@@ -183,7 +178,7 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage,
         }
     }
     const glm::dvec3 origin = loadDvec3(header.data() + h::kCubeOrigin);
-    const auto edge = load<double>(header.data() + h::kCubeEdge);
+    const auto edge = loadRaw<double>(header.data() + h::kCubeEdge);
     const glm::dvec3 sourceOffset = loadDvec3(header.data() + h::kSourceOffset);
     if (!isFinite(origin)) {
         throw error(InputErrorKind::MalformedHeader, h::kCubeOrigin,
@@ -197,7 +192,7 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage,
         throw error(InputErrorKind::MalformedHeader, h::kSourceOffset,
                     "expected a finite source offset");
     }
-    const auto pointCount = load<std::uint64_t>(header.data() + h::kPointCount);
+    const auto pointCount = loadRaw<std::uint64_t>(header.data() + h::kPointCount);
     if (pointCount == 0) {
         throw error(InputErrorKind::NoPoints, h::kPointCount,
                     "the header declares 0 points, expected at least one");
@@ -248,13 +243,13 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage,
                     "expected the footer magic " + quoteMagic(oms::kFooterMagic) + ", found " +
                         quoteBytes(footer.data() + f::kMagic, oms::kFooterMagic.size()));
     }
-    const auto footerCount = load<std::uint64_t>(footer.data() + f::kPointCount);
+    const auto footerCount = loadRaw<std::uint64_t>(footer.data() + f::kPointCount);
     if (footerCount != pointCount) {
         throw error(InputErrorKind::CountMismatch, footerStart + f::kPointCount,
                     "the footer's point count " + std::to_string(footerCount) +
                         " differs from the header's " + std::to_string(pointCount));
     }
-    m_expectedPayloadChecksum = load<std::uint64_t>(footer.data() + f::kChecksum);
+    m_expectedPayloadChecksum = loadRaw<std::uint64_t>(footer.data() + f::kChecksum);
 
     m_info.path = path;
     m_info.version = version;
@@ -300,7 +295,7 @@ ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptio
         const std::uint8_t* record = m_block.data();
         const SortedCloud::StagedRange out = cloud.stage(end);
         for (std::size_t i = begin; i < end; ++i, record += recordBytes) {
-            const auto p = load<glm::vec3>(record);
+            const auto p = loadRaw<glm::vec3>(record);
             if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
                 throw InputError(InputErrorKind::MalformedValue, m_info.path,
                                  InputLocation::byte(blockStart + (i - begin) * recordBytes),
@@ -321,13 +316,13 @@ ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptio
             const std::size_t at = i - begin;
             out.positions[at] = p;
             if (attributes.has(Attribute::Normal)) {
-                out.normals[at] = load<glm::vec3>(record + m_layout.normalOffset);
+                out.normals[at] = loadRaw<glm::vec3>(record + m_layout.normalOffset);
             }
             if (attributes.has(Attribute::Color)) {
-                out.colors[at] = load<glm::u8vec3>(record + m_layout.colorOffset);
+                out.colors[at] = loadRaw<glm::u8vec3>(record + m_layout.colorOffset);
             }
             if (attributes.has(Attribute::Intensity)) {
-                out.intensities[at] = load<std::uint16_t>(record + m_layout.intensityOffset);
+                out.intensities[at] = loadRaw<std::uint16_t>(record + m_layout.intensityOffset);
             }
             std::memcpy(out.las.data() + at * m_layout.lasBytes, record + m_layout.lasOffset,
                         m_layout.lasBytes);

@@ -1,5 +1,7 @@
 #include "formats/oms_writer.hpp"
 
+#include "io/raw_bytes.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -12,10 +14,6 @@ namespace {
 // Records are encoded into a block of about this size before being hashed and written.
 constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
 
-template <typename T> void store(std::uint8_t* at, const T& value) {
-    std::memcpy(at, &value, sizeof(T));
-}
-
 bool isFinite(const glm::dvec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
@@ -27,20 +25,20 @@ std::array<std::uint8_t, oms::kHeaderBytes> encodeHeader(const CubeTransform& cu
     namespace h = oms::header;
     std::array<std::uint8_t, oms::kHeaderBytes> bytes{}; // reserved fields stay zero
     std::memcpy(bytes.data() + h::kMagic, oms::kMagic.data(), oms::kMagic.size());
-    store(bytes.data() + h::kVersion, oms::kVersion);
-    store(bytes.data() + h::kEndianness, oms::kEndiannessMarker);
-    store(bytes.data() + h::kPointCount, pointCount);
-    store(bytes.data() + h::kSortDepth, oms::kSortDepth);
-    store(bytes.data() + h::kAttributes, attributes.bits());
-    store(bytes.data() + h::kRecordBytes,
+    storeRaw(bytes.data() + h::kVersion, oms::kVersion);
+    storeRaw(bytes.data() + h::kEndianness, oms::kEndiannessMarker);
+    storeRaw(bytes.data() + h::kPointCount, pointCount);
+    storeRaw(bytes.data() + h::kSortDepth, oms::kSortDepth);
+    storeRaw(bytes.data() + h::kAttributes, attributes.bits());
+    storeRaw(bytes.data() + h::kRecordBytes,
           static_cast<std::uint16_t>(oms::RecordLayout::of(attributes).bytes));
-    store(bytes.data() + h::kExtraBytes, attributes.extraBytes());
+    storeRaw(bytes.data() + h::kExtraBytes, attributes.extraBytes());
     for (int axis = 0; axis < 3; ++axis) {
-        store(bytes.data() + h::kCubeOrigin + 8 * axis, cube.origin[axis]);
-        store(bytes.data() + h::kSourceOffset + 8 * axis, sourceOffset[axis]);
+        storeRaw(bytes.data() + h::kCubeOrigin + 8 * axis, cube.origin[axis]);
+        storeRaw(bytes.data() + h::kSourceOffset + 8 * axis, sourceOffset[axis]);
     }
-    store(bytes.data() + h::kCubeEdge, cube.edge);
-    store(bytes.data() + h::kChecksum, oms::headerChecksum(bytes.data()));
+    storeRaw(bytes.data() + h::kCubeEdge, cube.edge);
+    storeRaw(bytes.data() + h::kChecksum, oms::headerChecksum(bytes.data()));
     return bytes;
 }
 
@@ -120,15 +118,15 @@ void OmsWriter::append(const SortedCloud& cloud, std::size_t begin, std::size_t 
                      " is out of Morton order: the cloud is not sorted");
             }
             m_lastCode = code;
-            store(record, p);
+            storeRaw(record, p);
             if (m_attributes.has(Attribute::Normal)) {
-                store(record + m_layout.normalOffset, normals[i]);
+                storeRaw(record + m_layout.normalOffset, normals[i]);
             }
             if (m_attributes.has(Attribute::Color)) {
-                store(record + m_layout.colorOffset, cloud.color(i));
+                storeRaw(record + m_layout.colorOffset, cloud.color(i));
             }
             if (m_attributes.has(Attribute::Intensity)) {
-                store(record + m_layout.intensityOffset, intensities[i]);
+                storeRaw(record + m_layout.intensityOffset, intensities[i]);
             }
             std::memcpy(record + m_layout.lasOffset, cloud.lasRecord(i), m_layout.lasBytes);
         }
@@ -179,8 +177,8 @@ void OmsWriter::finish() {
     namespace f = oms::footer;
     std::array<std::uint8_t, oms::kFooterBytes> footer{};
     std::memcpy(footer.data() + f::kMagic, oms::kFooterMagic.data(), oms::kFooterMagic.size());
-    store(footer.data() + f::kPointCount, m_pointCount);
-    store(footer.data() + f::kChecksum, m_checksum->digest());
+    storeRaw(footer.data() + f::kPointCount, m_pointCount);
+    storeRaw(footer.data() + f::kChecksum, m_checksum->digest());
     m_file->write(footer.data(), footer.size());
     m_file->commit();
     m_file.reset();

@@ -1,5 +1,6 @@
 #include "formats/potree_attributes.hpp"
 
+#include "io/raw_bytes.hpp"
 #include "points/las_fields.hpp"
 
 #include <algorithm>
@@ -12,10 +13,6 @@
 namespace omicron {
 
 namespace {
-
-template <typename T> void store(std::uint8_t* at, const T& value) {
-    std::memcpy(at, &value, sizeof(T));
-}
 
 std::string number(double value) {
     char text[32];
@@ -102,14 +99,14 @@ void PotreeRecordEncoder::encode(std::uint32_t index, std::uint8_t* record) {
     const glm::vec3 unit = m_cloud.position(index);
     for (int axis = 0; axis < 3; ++axis) {
         const std::int32_t stored = potreeQuantize(unit[axis]);
-        store(record + 4 * axis, stored);
+        storeRaw(record + 4 * axis, stored);
         m_positionMin[axis] = std::min(m_positionMin[axis], stored);
         m_positionMax[axis] = std::max(m_positionMax[axis], stored);
     }
     std::size_t at = 12;
     if (m_intensity) {
         const std::uint16_t value = m_cloud.intensities()[index];
-        store(record + at, value);
+        storeRaw(record + at, value);
         m_intensityMin = std::min(m_intensityMin, value);
         m_intensityMax = std::max(m_intensityMax, value);
         at += 2;
@@ -119,12 +116,12 @@ void PotreeRecordEncoder::encode(std::uint32_t index, std::uint8_t* record) {
         record[at] = static_cast<std::uint8_t>(fields.returnNumber());
         record[at + 1] = static_cast<std::uint8_t>(fields.numberOfReturns());
         record[at + 2] = fields.classification;
-        store(record + at + 3, fields.scanAngle);
+        storeRaw(record + at + 3, fields.scanAngle);
         record[at + 5] = fields.userData;
-        store(record + at + 6, fields.pointSourceId);
+        storeRaw(record + at + 6, fields.pointSourceId);
         at += 8;
         if (m_gpsTime) {
-            store(record + at, fields.gpsTime);
+            storeRaw(record + at, fields.gpsTime);
             at += 8;
         }
         const std::array<double, 7> values = lasFieldValues(fields);
@@ -137,7 +134,7 @@ void PotreeRecordEncoder::encode(std::uint32_t index, std::uint8_t* record) {
         const glm::u8vec3 color = m_cloud.color(index);
         for (int c = 0; c < 3; ++c) {
             const auto value = static_cast<std::uint16_t>(color[c] * 257u);
-            store(record + at + 2 * c, value);
+            storeRaw(record + at + 2 * c, value);
             m_rgbMin[c] = std::min(m_rgbMin[c], value);
             m_rgbMax[c] = std::max(m_rgbMax[c], value);
         }

@@ -1,6 +1,7 @@
 #include "io/las/las_header.hpp"
 
 #include "io/input_error.hpp"
+#include "io/raw_bytes.hpp"
 
 #include <array>
 #include <bit>
@@ -22,12 +23,6 @@ constexpr std::array<std::uint16_t, kMaxPointFormat + 1> kMinimumRecordLengths =
 // Red's offset per format, 0 for formats without colour.
 constexpr std::array<std::uint8_t, kMaxPointFormat + 1> kColorOffsets = {0, 0,  20, 28, 0, 28,
                                                                          0, 30, 30, 0,  30};
-
-template <typename T> T load(const std::uint8_t* bytes) {
-    T value;
-    std::memcpy(&value, bytes, sizeof value);
-    return value;
-}
 
 std::string number(double value) {
     char text[64];
@@ -111,7 +106,7 @@ private:
 
     void checkHeaderSize() {
         const std::uint16_t required = requiredHeaderSize(m_header.versionMinor);
-        m_header.headerSize = load<std::uint16_t>(&m_bytes[field::headerSize]);
+        m_header.headerSize = loadRaw<std::uint16_t>(&m_bytes[field::headerSize]);
         if (m_header.headerSize < required) {
             fail(InputErrorKind::MalformedHeader, field::headerSize,
                  "header size " + std::to_string(m_header.headerSize) + " is shorter than LAS 1." +
@@ -134,7 +129,7 @@ private:
     }
 
     void checkPointDataOffset() {
-        m_header.pointDataOffset = load<std::uint32_t>(&m_bytes[field::pointDataOffset]);
+        m_header.pointDataOffset = loadRaw<std::uint32_t>(&m_bytes[field::pointDataOffset]);
         if (m_header.pointDataOffset < m_header.headerSize) {
             fail(InputErrorKind::MalformedHeader, field::pointDataOffset,
                  "offset to point data " + std::to_string(m_header.pointDataOffset) +
@@ -164,7 +159,7 @@ private:
     }
 
     void walkRecords() {
-        const std::uint32_t vlrCount = load<std::uint32_t>(&m_bytes[field::vlrCount]);
+        const std::uint32_t vlrCount = loadRaw<std::uint32_t>(&m_bytes[field::vlrCount]);
         std::uint64_t position = m_header.headerSize;
         std::array<std::uint8_t, kVlrHeaderSize> vlr{};
         for (std::uint32_t i = 0; i < vlrCount; ++i) {
@@ -174,8 +169,8 @@ private:
             m_stream.seek(position);
             m_stream.readExact(vlr.data(), vlr.size(), "a variable length record header");
             const char* userId = reinterpret_cast<const char*>(&vlr[2]);
-            const std::uint16_t recordId = load<std::uint16_t>(&vlr[18]);
-            const std::uint16_t length = load<std::uint16_t>(&vlr[20]);
+            const std::uint16_t recordId = loadRaw<std::uint16_t>(&vlr[18]);
+            const std::uint16_t length = loadRaw<std::uint16_t>(&vlr[20]);
             if (recordId == kLaszipRecordId && std::strncmp(userId, "laszip encoded", 16) == 0) {
                 m_header.compressed = true;
                 m_header.laszipRecordOffset = position + kVlrHeaderSize;
@@ -187,7 +182,7 @@ private:
     }
 
     void checkRecordLength() {
-        m_header.recordLength = load<std::uint16_t>(&m_bytes[field::recordLength]);
+        m_header.recordLength = loadRaw<std::uint16_t>(&m_bytes[field::recordLength]);
         const std::uint16_t minimum = minimumRecordLength(m_header.pointFormat);
         if (m_header.recordLength < minimum) {
             fail(InputErrorKind::MalformedHeader, field::recordLength,
@@ -201,14 +196,14 @@ private:
         const char* axes = "xyz";
         for (int axis = 0; axis < 3; ++axis) {
             const std::size_t scaleAt = field::scale + 8 * axis;
-            const double scale = load<double>(&m_bytes[scaleAt]);
+            const double scale = loadRaw<double>(&m_bytes[scaleAt]);
             if (!std::isfinite(scale) || scale == 0.0) {
                 fail(InputErrorKind::MalformedHeader, scaleAt,
                      std::string(1, axes[axis]) + " scale factor is " + number(scale) +
                          ", expected a finite non-zero number");
             }
             const std::size_t offsetAt = field::offset + 8 * axis;
-            const double offset = load<double>(&m_bytes[offsetAt]);
+            const double offset = loadRaw<double>(&m_bytes[offsetAt]);
             if (!std::isfinite(offset)) {
                 fail(InputErrorKind::MalformedHeader, offsetAt,
                      std::string(1, axes[axis]) + " offset is " + number(offset) +
@@ -222,11 +217,11 @@ private:
     // LAS 1.4 keeps the legacy 32-bit count for old readers and may leave it 0; the 64-bit
     // count is the real one. Some writers fill only the legacy count, so a 0 there falls back.
     void readPointCount() {
-        const std::uint64_t legacy = load<std::uint32_t>(&m_bytes[field::legacyPointCount]);
+        const std::uint64_t legacy = loadRaw<std::uint32_t>(&m_bytes[field::legacyPointCount]);
         m_countField = field::legacyPointCount;
         m_header.pointCount = legacy;
         if (m_header.versionMinor >= 4) {
-            const std::uint64_t full = load<std::uint64_t>(&m_bytes[field::pointCount]);
+            const std::uint64_t full = loadRaw<std::uint64_t>(&m_bytes[field::pointCount]);
             if (full != 0 && legacy != 0 && full != legacy) {
                 fail(InputErrorKind::CountMismatch, field::pointCount,
                      "the 64-bit point count " + std::to_string(full) +
@@ -267,7 +262,7 @@ private:
 
     void readDeclaredBounds() {
         const auto at = [&](int index) {
-            return load<double>(&m_bytes[field::bounds + 8 * index]);
+            return loadRaw<double>(&m_bytes[field::bounds + 8 * index]);
         };
         m_header.declaredBounds.max = {at(0), at(2), at(4)};
         m_header.declaredBounds.min = {at(1), at(3), at(5)};

@@ -1,6 +1,7 @@
 #include "io/las/las_point_fields.hpp"
 
 #include "io/las/las_header.hpp"
+#include "io/raw_bytes.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -32,16 +33,6 @@ constexpr std::size_t kNir = 36;       // formats 8 and 10
 
 // 1 / 0.006: steps of the LAS 1.4 scan angle per degree.
 constexpr double kScanStepsPerDegree = 1000.0 / 6.0;
-
-template <typename T> T load(const std::uint8_t* bytes) {
-    T value;
-    std::memcpy(&value, bytes, sizeof value);
-    return value;
-}
-
-template <typename T> void store(std::uint8_t* bytes, T value) {
-    std::memcpy(bytes, &value, sizeof value);
-}
 
 } // namespace
 
@@ -82,11 +73,11 @@ LasFields readLasFields(const std::uint8_t* record, std::uint8_t pointFormat) {
         fields.classification = classByte & 0x1f;
         fields.flags = static_cast<std::uint8_t>((classByte >> 5) | (returns & 0xc0));
         fields.scanAngle = static_cast<std::int16_t>(
-            std::lround(load<std::int8_t>(record + legacy::kScanRank) * kScanStepsPerDegree));
+            std::lround(loadRaw<std::int8_t>(record + legacy::kScanRank) * kScanStepsPerDegree));
         fields.userData = record[legacy::kUserData];
-        fields.pointSourceId = load<std::uint16_t>(record + legacy::kSourceId);
+        fields.pointSourceId = loadRaw<std::uint16_t>(record + legacy::kSourceId);
         if (formatHasGpsTime(pointFormat)) {
-            fields.gpsTime = load<double>(record + legacy::kGpsTime);
+            fields.gpsTime = loadRaw<double>(record + legacy::kGpsTime);
         }
         return fields;
     }
@@ -94,11 +85,11 @@ LasFields readLasFields(const std::uint8_t* record, std::uint8_t pointFormat) {
     fields.flags = record[v14::kFlags];
     fields.classification = record[v14::kClass];
     fields.userData = record[v14::kUserData];
-    fields.scanAngle = load<std::int16_t>(record + v14::kScanAngle);
-    fields.pointSourceId = load<std::uint16_t>(record + v14::kSourceId);
-    fields.gpsTime = load<double>(record + v14::kGpsTime);
+    fields.scanAngle = loadRaw<std::int16_t>(record + v14::kScanAngle);
+    fields.pointSourceId = loadRaw<std::uint16_t>(record + v14::kSourceId);
+    fields.gpsTime = loadRaw<double>(record + v14::kGpsTime);
     if (formatHasNir(pointFormat)) {
-        fields.nir = load<std::uint16_t>(record + v14::kNir);
+        fields.nir = loadRaw<std::uint16_t>(record + v14::kNir);
     }
     return fields;
 }
@@ -112,11 +103,11 @@ void writeLasFields(const LasFields& fields, std::uint8_t pointFormat, std::uint
         record[legacy::kClass] = static_cast<std::uint8_t>(
             std::min<int>(fields.classification, 31) | (fields.flags & 0x07) << 5);
         const long degrees = std::lround(fields.scanAngleDegrees());
-        store(record + legacy::kScanRank, static_cast<std::int8_t>(std::clamp(degrees, -90L, 90L)));
+        storeRaw(record + legacy::kScanRank, static_cast<std::int8_t>(std::clamp(degrees, -90L, 90L)));
         record[legacy::kUserData] = fields.userData;
-        store(record + legacy::kSourceId, fields.pointSourceId);
+        storeRaw(record + legacy::kSourceId, fields.pointSourceId);
         if (formatHasGpsTime(pointFormat)) {
-            store(record + legacy::kGpsTime, fields.gpsTime);
+            storeRaw(record + legacy::kGpsTime, fields.gpsTime);
         }
         return;
     }
@@ -124,11 +115,11 @@ void writeLasFields(const LasFields& fields, std::uint8_t pointFormat, std::uint
     record[v14::kFlags] = fields.flags;
     record[v14::kClass] = fields.classification;
     record[v14::kUserData] = fields.userData;
-    store(record + v14::kScanAngle, fields.scanAngle);
-    store(record + v14::kSourceId, fields.pointSourceId);
-    store(record + v14::kGpsTime, fields.gpsTime);
+    storeRaw(record + v14::kScanAngle, fields.scanAngle);
+    storeRaw(record + v14::kSourceId, fields.pointSourceId);
+    storeRaw(record + v14::kGpsTime, fields.gpsTime);
     if (formatHasNir(pointFormat)) {
-        store(record + v14::kNir, fields.nir);
+        storeRaw(record + v14::kNir, fields.nir);
     }
 }
 

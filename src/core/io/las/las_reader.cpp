@@ -7,6 +7,7 @@
 #include "io/las/las_point_fields.hpp"
 #include "io/laz/laz_records.hpp"
 #include "io/pre_pass_monitor.hpp"
+#include "io/raw_bytes.hpp"
 #include "io/source_normalizer.hpp"
 
 #include <algorithm>
@@ -25,12 +26,6 @@ namespace {
 
 // How many records, spread evenly over the file, decide the colour depth.
 constexpr std::uint64_t kColorSampleRecords = 4096;
-
-template <typename T> T load(const std::uint8_t* bytes) {
-    T value;
-    std::memcpy(&value, bytes, sizeof value);
-    return value;
-}
 
 // LAS stores colour in 16-bit fields, but many writers put 8-bit values there unscaled.
 enum class ColorDepth {
@@ -81,17 +76,17 @@ private:
     }
 
     glm::dvec3 sourcePosition(const std::uint8_t* record) const {
-        return glm::dvec3(load<std::int32_t>(record), load<std::int32_t>(record + 4),
-                          load<std::int32_t>(record + 8)) *
+        return glm::dvec3(loadRaw<std::int32_t>(record), loadRaw<std::int32_t>(record + 4),
+                          loadRaw<std::int32_t>(record + 8)) *
                    m_header.scale +
                m_header.offset;
     }
 
     glm::u8vec3 color(const std::uint8_t* record) const {
         const std::uint8_t* rgb = record + m_colorOffset;
-        const int red = load<std::uint16_t>(rgb);
-        const int green = load<std::uint16_t>(rgb + 2);
-        const int blue = load<std::uint16_t>(rgb + 4);
+        const int red = loadRaw<std::uint16_t>(rgb);
+        const int green = loadRaw<std::uint16_t>(rgb + 2);
+        const int blue = loadRaw<std::uint16_t>(rgb + 4);
         if (m_colorDepth == ColorDepth::SixteenBit) {
             return {(red + 128) / 257, (green + 128) / 257, (blue + 128) / 257};
         }
@@ -141,7 +136,7 @@ private:
         m_colorSamples =
             m_records->sampleRecords(kColorSampleRecords, [&](const std::uint8_t* record) {
                 for (int channel = 0; channel < 3; ++channel) {
-                    if (load<std::uint16_t>(record + m_colorOffset + 2 * channel) > 255) {
+                    if (loadRaw<std::uint16_t>(record + m_colorOffset + 2 * channel) > 255) {
                         sixteenBit = true;
                     }
                 }
@@ -236,7 +231,7 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
             }
             batch.positions.push_back(
                 normalizer.toUnit(glm::clamp(source, bounds.min, bounds.max)));
-            batch.intensities.push_back(load<std::uint16_t>(record + las::kRecordIntensity));
+            batch.intensities.push_back(loadRaw<std::uint16_t>(record + las::kRecordIntensity));
             if (hasColor) {
                 batch.colors.push_back(color(record));
             }

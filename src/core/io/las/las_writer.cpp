@@ -2,6 +2,7 @@
 
 #include "io/las/las_header.hpp"
 #include "io/las/las_point_fields.hpp"
+#include "io/raw_bytes.hpp"
 
 #include <algorithm>
 #include <array>
@@ -28,10 +29,6 @@ constexpr std::uint8_t kSingleReturn14 = 0x11;
 
 // LAS 1.4 requires a WKT coordinate system (global encoding bit 4) for formats 6 to 10.
 constexpr std::uint16_t kGlobalEncodingWkt = 1u << 4;
-
-template <typename T> void store(std::uint8_t* bytes, const T& value) {
-    std::memcpy(bytes, &value, sizeof value);
-}
 
 void storeText(std::uint8_t* bytes, std::size_t capacity, const std::string& text) {
     std::memcpy(bytes, text.data(), std::min(capacity, text.size()));
@@ -109,34 +106,34 @@ std::vector<std::uint8_t> headerBytes(const LasWriteOptions& o, std::uint64_t co
     std::vector<std::uint8_t> header(las::kHeaderSize14, 0);
     std::memcpy(&header[field::signature], "LASF", 4);
     if (o.pointFormat > 5) {
-        store<std::uint16_t>(&header[field::globalEncoding], kGlobalEncodingWkt);
+        storeRaw<std::uint16_t>(&header[field::globalEncoding], kGlobalEncodingWkt);
     }
     header[field::versionMajor] = 1;
     header[field::versionMinor] = o.versionMinor;
     storeText(&header[field::systemIdentifier], 32, "OTHER");
     storeText(&header[field::generatingSoftware], 32, "omicron");
-    store<std::uint16_t>(&header[field::headerSize], headerSize);
-    store<std::uint32_t>(&header[field::pointDataOffset], pointDataOffset(o));
-    store<std::uint32_t>(&header[field::vlrCount], static_cast<std::uint32_t>(o.vlrs.size()));
+    storeRaw<std::uint16_t>(&header[field::headerSize], headerSize);
+    storeRaw<std::uint32_t>(&header[field::pointDataOffset], pointDataOffset(o));
+    storeRaw<std::uint32_t>(&header[field::vlrCount], static_cast<std::uint32_t>(o.vlrs.size()));
     header[field::pointFormat] = o.pointFormat;
-    store<std::uint16_t>(&header[field::recordLength], recordLength(o));
+    storeRaw<std::uint16_t>(&header[field::recordLength], recordLength(o));
     // LAS 1.4 leaves the legacy counts 0 for formats 6 to 10 and for counts over 2^32.
     const bool legacyCountFits =
         o.pointFormat <= 5 && count <= std::numeric_limits<std::uint32_t>::max();
     if (legacyCountFits) {
-        store<std::uint32_t>(&header[field::legacyPointCount], static_cast<std::uint32_t>(count));
-        store<std::uint32_t>(&header[field::legacyPointsByReturn],
+        storeRaw<std::uint32_t>(&header[field::legacyPointCount], static_cast<std::uint32_t>(count));
+        storeRaw<std::uint32_t>(&header[field::legacyPointsByReturn],
                              static_cast<std::uint32_t>(count));
     }
     for (int axis = 0; axis < 3; ++axis) {
-        store<double>(&header[field::scale + 8 * axis], o.scale[axis]);
-        store<double>(&header[field::offset + 8 * axis], o.offset[axis]);
-        store<double>(&header[field::bounds + 16 * axis], bounds.max[axis]);
-        store<double>(&header[field::bounds + 16 * axis + 8], bounds.min[axis]);
+        storeRaw<double>(&header[field::scale + 8 * axis], o.scale[axis]);
+        storeRaw<double>(&header[field::offset + 8 * axis], o.offset[axis]);
+        storeRaw<double>(&header[field::bounds + 16 * axis], bounds.max[axis]);
+        storeRaw<double>(&header[field::bounds + 16 * axis + 8], bounds.min[axis]);
     }
     if (o.versionMinor >= 4) {
-        store<std::uint64_t>(&header[field::pointCount], count);
-        store<std::uint64_t>(&header[field::pointsByReturn], count);
+        storeRaw<std::uint64_t>(&header[field::pointCount], count);
+        storeRaw<std::uint64_t>(&header[field::pointsByReturn], count);
     }
     header.resize(headerSize);
     return header;
@@ -146,8 +143,8 @@ void writeVlrs(AtomicFileWriter& file, const LasWriteOptions& options) {
     for (const LasVariableLengthRecord& vlr : options.vlrs) {
         std::array<std::uint8_t, las::kVlrHeaderSize> bytes{};
         storeText(&bytes[2], 16, vlr.userId);
-        store<std::uint16_t>(&bytes[18], vlr.recordId);
-        store<std::uint16_t>(&bytes[20], static_cast<std::uint16_t>(vlr.payload.size()));
+        storeRaw<std::uint16_t>(&bytes[18], vlr.recordId);
+        storeRaw<std::uint16_t>(&bytes[20], static_cast<std::uint16_t>(vlr.payload.size()));
         storeText(&bytes[22], 32, vlr.description);
         file.write(bytes.data(), bytes.size());
         file.write(vlr.payload.data(), vlr.payload.size());
@@ -211,11 +208,11 @@ void LasStreamWriter::append(const PointBatch& points, const CubeTransform& cube
                 }
             }
             m_steps.extend(q);
-            store(record, static_cast<std::int32_t>(q.x));
-            store(record + 4, static_cast<std::int32_t>(q.y));
-            store(record + 8, static_cast<std::int32_t>(q.z));
+            storeRaw(record, static_cast<std::int32_t>(q.x));
+            storeRaw(record + 4, static_cast<std::int32_t>(q.y));
+            storeRaw(record + 8, static_cast<std::int32_t>(q.z));
             if (hasIntensity) {
-                store(record + las::kRecordIntensity, points.intensities[index]);
+                storeRaw(record + las::kRecordIntensity, points.intensities[index]);
             }
             if (lasLayout.bytes != 0) {
                 const std::uint8_t* column = points.las.data() + index * lasLayout.bytes;
@@ -226,9 +223,9 @@ void LasStreamWriter::append(const PointBatch& points, const CubeTransform& cube
             }
             if (writesColor) {
                 const glm::u8vec3 c = points.colors[index];
-                store(record + colorAt, static_cast<std::uint16_t>(c.r * 257));
-                store(record + colorAt + 2, static_cast<std::uint16_t>(c.g * 257));
-                store(record + colorAt + 4, static_cast<std::uint16_t>(c.b * 257));
+                storeRaw(record + colorAt, static_cast<std::uint16_t>(c.r * 257));
+                storeRaw(record + colorAt + 2, static_cast<std::uint16_t>(c.g * 257));
+                storeRaw(record + colorAt + 4, static_cast<std::uint16_t>(c.b * 257));
             }
         }
         m_file->write(m_chunk.data(), m_chunk.size());

@@ -1,6 +1,7 @@
 #include "io/laz/copc_hierarchy.hpp"
 
 #include "io/input_error.hpp"
+#include "io/raw_bytes.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -15,12 +16,6 @@ constexpr std::size_t kEntryBytes = 32;
 // A root page larger than this is not read for a preview (a real one holds a few thousand
 // entries): bounds the allocation whatever the file claims.
 constexpr std::uint64_t kMaxPageBytes = std::uint64_t{32} << 20;
-
-template <typename T> T load(const std::uint8_t* bytes) {
-    T value;
-    std::memcpy(&value, bytes, sizeof value);
-    return value;
-}
 
 [[noreturn]] void fail(const FileStream& stream, std::uint64_t at, const std::string& why) {
     throw InputError(InputErrorKind::MalformedHeader, stream.path(), InputLocation::byte(at),
@@ -37,25 +32,25 @@ std::optional<CopcInfo> readCopcInfo(FileStream& stream, const las::Header& head
     std::uint8_t vlr[las::kVlrHeaderSize];
     stream.seek(vlrAt);
     stream.readExact(vlr, sizeof vlr, "the first variable length record");
-    const bool copc = std::memcmp(vlr + 2, "copc\0", 5) == 0 && load<std::uint16_t>(vlr + 18) == 1;
+    const bool copc = std::memcmp(vlr + 2, "copc\0", 5) == 0 && loadRaw<std::uint16_t>(vlr + 18) == 1;
     if (!copc) {
         return std::nullopt;
     }
-    if (load<std::uint16_t>(vlr + 20) != kInfoBytes) {
+    if (loadRaw<std::uint16_t>(vlr + 20) != kInfoBytes) {
         fail(stream, vlrAt + 20, "the info record holds " +
-                                     std::to_string(load<std::uint16_t>(vlr + 20)) +
+                                     std::to_string(loadRaw<std::uint16_t>(vlr + 20)) +
                                      " bytes, expected 160");
     }
     std::uint8_t payload[kInfoBytes];
     stream.readExact(payload, sizeof payload, "the COPC info record");
     CopcInfo info;
     for (int axis = 0; axis < 3; ++axis) {
-        info.center[axis] = load<double>(payload + 8 * axis);
+        info.center[axis] = loadRaw<double>(payload + 8 * axis);
     }
-    info.halfSize = load<double>(payload + 24);
-    info.spacing = load<double>(payload + 32);
-    info.rootPageOffset = load<std::uint64_t>(payload + 40);
-    info.rootPageBytes = load<std::uint64_t>(payload + 48);
+    info.halfSize = loadRaw<double>(payload + 24);
+    info.spacing = loadRaw<double>(payload + 32);
+    info.rootPageOffset = loadRaw<std::uint64_t>(payload + 40);
+    info.rootPageBytes = loadRaw<std::uint64_t>(payload + 48);
     const std::uint64_t at = vlrAt + las::kVlrHeaderSize + 40;
     if (info.rootPageBytes == 0 || info.rootPageBytes % kEntryBytes != 0 ||
         info.rootPageBytes > kMaxPageBytes) {
@@ -80,13 +75,13 @@ std::vector<CopcNode> readCopcTopNodes(FileStream& stream, const CopcInfo& info,
     std::map<std::int32_t, std::vector<CopcNode>> levels;
     for (std::size_t e = 0; e < page.size(); e += kEntryBytes) {
         const std::uint8_t* entry = page.data() + e;
-        const auto pointCount = load<std::int32_t>(entry + 28);
-        const auto bytes = load<std::int32_t>(entry + 24);
-        CopcNode node{load<std::int32_t>(entry),
-                      load<std::int32_t>(entry + 4),
-                      load<std::int32_t>(entry + 8),
-                      load<std::int32_t>(entry + 12),
-                      load<std::uint64_t>(entry + 16),
+        const auto pointCount = loadRaw<std::int32_t>(entry + 28);
+        const auto bytes = loadRaw<std::int32_t>(entry + 24);
+        CopcNode node{loadRaw<std::int32_t>(entry),
+                      loadRaw<std::int32_t>(entry + 4),
+                      loadRaw<std::int32_t>(entry + 8),
+                      loadRaw<std::int32_t>(entry + 12),
+                      loadRaw<std::uint64_t>(entry + 16),
                       static_cast<std::uint32_t>(std::max(bytes, 0)),
                       static_cast<std::uint32_t>(std::max(pointCount, 0))};
         if (pointCount <= 0 || node.level < 0) {

@@ -1,6 +1,7 @@
 #include "io/laz/point10_decoder.hpp"
 
 #include "io/laz/return_contexts.hpp"
+#include "io/raw_bytes.hpp"
 
 #include <bit>
 #include <cstring>
@@ -10,16 +11,6 @@ static_assert(std::endian::native == std::endian::little, "LAS fields are stored
 namespace omicron::laz {
 
 namespace {
-
-template <typename T> T load(const std::uint8_t* bytes) {
-    T value;
-    std::memcpy(&value, bytes, sizeof value);
-    return value;
-}
-
-template <typename T> void store(std::uint8_t* bytes, T value) {
-    std::memcpy(bytes, &value, sizeof value);
-}
 
 // Which fields changed, in the bit mask each point starts with.
 constexpr unsigned kReturnBitsChanged = 1u << 5;
@@ -48,16 +39,16 @@ SymbolModel& Point10Decoder::modelFor(ModelPerByte& models, std::uint8_t previou
 }
 
 void Point10Decoder::start(const std::uint8_t* item) {
-    m_last.x = load<std::int32_t>(item);
-    m_last.y = load<std::int32_t>(item + 4);
-    m_last.z = load<std::int32_t>(item + 8);
+    m_last.x = loadRaw<std::int32_t>(item);
+    m_last.y = loadRaw<std::int32_t>(item + 4);
+    m_last.z = loadRaw<std::int32_t>(item + 8);
     // The first intensity is not a prediction: LASzip starts from 0 in every context.
     m_last.intensity = 0;
     m_last.returnBits = item[14];
     m_last.classification = item[15];
     m_last.scanAngleRank = item[16];
     m_last.userData = item[17];
-    m_last.pointSourceId = load<std::uint16_t>(item + 18);
+    m_last.pointSourceId = loadRaw<std::uint16_t>(item + 18);
 }
 
 void Point10Decoder::decode(ArithmeticDecoder& decoder, std::uint8_t* item) {
@@ -112,15 +103,15 @@ void Point10Decoder::decode(ArithmeticDecoder& decoder, std::uint8_t* item) {
     m_last.z = m_z.decode(decoder, m_lastHeight[level], single + evenClass(zClass, 18));
     m_lastHeight[level] = m_last.z;
 
-    store(item, m_last.x);
-    store(item + 4, m_last.y);
-    store(item + 8, m_last.z);
-    store(item + 12, m_last.intensity);
+    storeRaw(item, m_last.x);
+    storeRaw(item + 4, m_last.y);
+    storeRaw(item + 8, m_last.z);
+    storeRaw(item + 12, m_last.intensity);
     item[14] = m_last.returnBits;
     item[15] = m_last.classification;
     item[16] = m_last.scanAngleRank;
     item[17] = m_last.userData;
-    store(item + 18, m_last.pointSourceId);
+    storeRaw(item + 18, m_last.pointSourceId);
 }
 
 } // namespace omicron::laz

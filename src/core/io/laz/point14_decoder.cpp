@@ -1,6 +1,7 @@
 #include "io/laz/point14_decoder.hpp"
 
 #include "io/laz/return_contexts.hpp"
+#include "io/raw_bytes.hpp"
 
 #include <bit>
 #include <cassert>
@@ -31,16 +32,6 @@ constexpr unsigned kGpsTimeChanged = 1u << 4;
 constexpr unsigned kScanAngleChanged = 1u << 3;
 constexpr unsigned kNumberOfReturnsChanged = 1u << 2;
 constexpr unsigned kReturnNumberChange = 3u; // 0 same, 1 plus one, 2 minus one, 3 coded
-
-template <typename T> T load(const std::uint8_t* bytes) {
-    T value;
-    std::memcpy(&value, bytes, sizeof value);
-    return value;
-}
-
-template <typename T> void put(std::uint8_t* bytes, T value) {
-    std::memcpy(bytes, &value, sizeof value);
-}
 
 std::uint32_t evenClass(std::uint32_t k, std::uint32_t limit) {
     return k < limit ? (k & ~1u) : limit;
@@ -103,10 +94,10 @@ Point14Decoder::~Point14Decoder() = default;
 
 Point14Decoder::Fields Point14Decoder::Fields::load(const std::uint8_t* item) {
     Fields f;
-    f.x = laz::load<std::int32_t>(item);
-    f.y = laz::load<std::int32_t>(item + 4);
-    f.z = laz::load<std::int32_t>(item + 8);
-    f.intensity = laz::load<std::uint16_t>(item + 12);
+    f.x = loadRaw<std::int32_t>(item);
+    f.y = loadRaw<std::int32_t>(item + 4);
+    f.z = loadRaw<std::int32_t>(item + 8);
+    f.intensity = loadRaw<std::uint16_t>(item + 12);
     f.returnNumber = item[14] & 15u;
     f.numberOfReturns = item[14] >> 4;
     f.classFlags = item[15] & 15u;
@@ -115,25 +106,25 @@ Point14Decoder::Fields Point14Decoder::Fields::load(const std::uint8_t* item) {
     f.edgeOfFlightLine = item[15] >> 7;
     f.classification = item[16];
     f.userData = item[17];
-    f.scanAngle = laz::load<std::int16_t>(item + 18);
-    f.pointSourceId = laz::load<std::uint16_t>(item + 20);
-    f.gpsTimeBits = laz::load<std::uint64_t>(item + 22);
+    f.scanAngle = loadRaw<std::int16_t>(item + 18);
+    f.pointSourceId = loadRaw<std::uint16_t>(item + 20);
+    f.gpsTimeBits = loadRaw<std::uint64_t>(item + 22);
     return f;
 }
 
 void Point14Decoder::Fields::store(std::uint8_t* item) const {
-    put(item, x);
-    put(item + 4, y);
-    put(item + 8, z);
-    put(item + 12, intensity);
+    storeRaw(item, x);
+    storeRaw(item + 4, y);
+    storeRaw(item + 8, z);
+    storeRaw(item + 12, intensity);
     item[14] = static_cast<std::uint8_t>(returnNumber | (numberOfReturns << 4));
     item[15] = static_cast<std::uint8_t>(classFlags | (scannerChannel << 4) | (scanDirection << 6) |
                                          (edgeOfFlightLine << 7));
     item[16] = classification;
     item[17] = userData;
-    put(item + 18, scanAngle);
-    put(item + 20, pointSourceId);
-    put(item + 22, gpsTimeBits);
+    storeRaw(item + 18, scanAngle);
+    storeRaw(item + 20, pointSourceId);
+    storeRaw(item + 22, gpsTimeBits);
 }
 
 Point14Decoder::Context& Point14Decoder::open(std::uint32_t channel, const Fields& from) {
