@@ -4,6 +4,7 @@
 #include "io/raw_bytes.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -92,6 +93,46 @@ LasFields readLasFields(const std::uint8_t* record, std::uint8_t pointFormat) {
         fields.nir = loadRaw<std::uint16_t>(record + v14::kNir);
     }
     return fields;
+}
+
+void readLasColumn(const std::uint8_t* record, std::uint8_t pointFormat,
+                   const LasColumnLayout& layout, std::uint8_t* column) {
+    if (pointFormat <= 5) {
+        // readLasFields's conversion, without its rounding per point: the scan angle steps of
+        // every rank come from a table.
+        static const std::array<std::int16_t, 256> kRankSteps = [] {
+            std::array<std::int16_t, 256> steps{};
+            for (int byte = 0; byte < 256; ++byte) {
+                steps[static_cast<std::size_t>(byte)] = static_cast<std::int16_t>(
+                    std::lround(static_cast<std::int8_t>(byte) * kScanStepsPerDegree));
+            }
+            return steps;
+        }();
+        const std::uint8_t returns = record[legacy::kReturns];
+        const std::uint8_t classByte = record[legacy::kClass];
+        column[0] = classByte & 0x1f;
+        column[1] = static_cast<std::uint8_t>((returns & 0x07) | ((returns >> 3) & 0x07) << 4);
+        column[2] = static_cast<std::uint8_t>((classByte >> 5) | (returns & 0xc0));
+        column[3] = record[legacy::kUserData];
+        storeRaw(column + 4, kRankSteps[record[legacy::kScanRank]]);
+        std::memcpy(column + 6, record + legacy::kSourceId, 2);
+        if (layout.gpsTimeOffset != 0) {
+            std::memcpy(column + layout.gpsTimeOffset, record + legacy::kGpsTime, 8);
+        }
+    } else {
+        // LAS 1.4's returns and flags bytes are the column's; class and user data follow.
+        column[0] = record[v14::kClass];
+        column[1] = record[v14::kReturns];
+        column[2] = record[v14::kFlags];
+        column[3] = record[v14::kUserData];
+        std::memcpy(column + 4, record + v14::kScanAngle, 4); // scan angle, point source ID
+        std::memcpy(column + layout.gpsTimeOffset, record + v14::kGpsTime, 8);
+        if (layout.nirOffset != 0) {
+            std::memcpy(column + layout.nirOffset, record + v14::kNir, 2);
+        }
+    }
+    std::memcpy(column + layout.extraOffset, record + minimumRecordLength(pointFormat),
+                layout.extraBytes);
 }
 
 void writeLasFields(const LasFields& fields, std::uint8_t pointFormat, std::uint8_t* record) {

@@ -24,6 +24,12 @@ AttributeSet attributesOfFormat(std::uint8_t pointFormat, std::uint16_t recordLe
 
 // The fields of `record` (a record of `pointFormat`).
 LasFields readLasFields(const std::uint8_t* record, std::uint8_t pointFormat);
+// Fills one point's LAS column (`layout` of the cloud's attributes) from `record` (of
+// `pointFormat`, `layout.extraBytes` extra bytes after its standard fields): the reader's hot
+// path, equal to encodeLasFields(readLasFields(record)) plus the extra bytes.
+void readLasColumn(const std::uint8_t* record, std::uint8_t pointFormat,
+                   const LasColumnLayout& layout, std::uint8_t* column);
+
 // Writes `fields` into `record` (of `pointFormat`, zeroed before): classification, returns,
 // flags, user data, scan angle, point source ID, and GPS time and NIR where the format has
 // them. A legacy format keeps classes 0 to 31 and scan angles rounded to whole degrees.

@@ -212,9 +212,8 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
     const Bounds& bounds = m_info.sourceBounds;
     const bool hasColor = m_colorDepth != ColorDepth::None;
     const std::size_t stride = m_header.recordLength;
-    const AttributeSet attributes = m_info.attributes;
-    const LasColumnLayout lasLayout = LasColumnLayout::of(attributes);
-    const std::size_t extraAt = las::minimumRecordLength(m_header.pointFormat);
+    const LasColumnLayout lasLayout = LasColumnLayout::of(m_info.attributes);
+    std::vector<std::uint8_t> column(lasLayout.bytes);
 
     const auto deliver = [&] {
         consumer(batch);
@@ -235,10 +234,10 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
             if (hasColor) {
                 batch.colors.push_back(color(record));
             }
-            batch.las.resize(batch.las.size() + lasLayout.bytes);
-            std::uint8_t* column = batch.las.data() + batch.las.size() - lasLayout.bytes;
-            encodeLasFields(attributes, las::readLasFields(record, m_header.pointFormat), column);
-            std::memcpy(column + lasLayout.extraOffset, record + extraAt, lasLayout.extraBytes);
+            // Assembled on the stack, appended without zero-filling (the capacity is reserved).
+            las::readLasColumn(record, m_header.pointFormat, lasLayout, column.data());
+            batch.las.insert(batch.las.end(), column.begin(),
+                             column.begin() + static_cast<std::ptrdiff_t>(lasLayout.bytes));
             if (batch.size() == batchPoints) {
                 deliver();
                 const bool morePoints = block.firstIndex + i + 1 < m_header.pointCount;

@@ -15,6 +15,7 @@
 #include <array>
 #include <cstring>
 #include <gtest/gtest.h>
+#include <random>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -95,6 +96,28 @@ TEST(LasFields, AttributesOfEveryFormat) {
         EXPECT_EQ(a.has(Attribute::GpsTime), format != 0 && format != 2);
         EXPECT_EQ(a.has(Attribute::Nir), format == 8 || format == 10);
         EXPECT_EQ(a.extraBytes(), 100 - las::minimumRecordLength(format));
+    }
+}
+
+// The reader's hot path equals the field-by-field conversion, for every format and byte.
+TEST(LasFields, ReadLasColumnEqualsTheFieldConversion) {
+    std::mt19937 random(5);
+    for (std::uint8_t format = 0; format <= 10; ++format) {
+        SCOPED_TRACE(static_cast<int>(format));
+        const std::uint16_t length = las::minimumRecordLength(format) + 3;
+        const AttributeSet attributes = las::attributesOfFormat(format, length);
+        const LasColumnLayout layout = LasColumnLayout::of(attributes);
+        std::vector<std::uint8_t> record(length), column(layout.bytes), expected(layout.bytes);
+        for (int trial = 0; trial < 2000; ++trial) {
+            for (std::uint8_t& byte : record) {
+                byte = static_cast<std::uint8_t>(random());
+            }
+            las::readLasColumn(record.data(), format, layout, column.data());
+            encodeLasFields(attributes, las::readLasFields(record.data(), format), expected.data());
+            std::memcpy(expected.data() + layout.extraOffset,
+                        record.data() + las::minimumRecordLength(format), 3);
+            ASSERT_EQ(column, expected) << "trial " << trial;
+        }
     }
 }
 
