@@ -19,8 +19,8 @@ ClassCounter::~ClassCounter() {
 }
 
 void ClassCounter::setHierarchy(std::shared_ptr<const Hierarchy> hierarchy) {
-    const SortedCloud* cloud = hierarchy ? &hierarchy->cloud() : nullptr;
-    if (cloud != nullptr && cloud == m_cloud) {
+    const std::shared_ptr<const SortedCloud> cloud = hierarchy ? hierarchy->sharedCloud() : nullptr;
+    if (cloud != nullptr && cloud == m_cloud.lock()) {
         return; // a rebuild over the same sorted points: the count goes on
     }
     m_thread = {}; // stops (the count checks between chunks) and joins the previous count

@@ -56,8 +56,10 @@ private:
     mutable std::mutex m_mutex;
     std::condition_variable_any m_wake; // the count's pause between polls of a growing cloud
     Snapshot m_snapshot;
-    const SortedCloud* m_cloud = nullptr; // the cloud being counted (identity only)
-    std::jthread m_thread;                // last: stopped and joined before the rest goes
+    // The cloud being counted, for its identity only (weak: a freed cloud's address may be
+    // reused by the next one).
+    std::weak_ptr<const SortedCloud> m_cloud;
+    std::jthread m_thread; // last: stopped and joined before the rest goes
 };
 
 } // namespace omicron
