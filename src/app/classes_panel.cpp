@@ -27,11 +27,8 @@ ClassesPanel::ClassesPanel(QWidget* parent) : QWidget(parent), m_model(new Class
     m_table->verticalHeader()->hide();
     m_table->setSelectionMode(QAbstractItemView::NoSelection);
     m_table->setEditTriggers(QAbstractItemView::NoEditTriggers);
+    // The name takes what the number and count columns leave (fitColumns sizes those).
     m_table->horizontalHeader()->setSectionResizeMode(ClassModel::NameColumn, QHeaderView::Stretch);
-    m_table->horizontalHeader()->setSectionResizeMode(ClassModel::ClassColumn,
-                                                      QHeaderView::ResizeToContents);
-    m_table->horizontalHeader()->setSectionResizeMode(ClassModel::PointsColumn,
-                                                      QHeaderView::ResizeToContents);
     m_summary = new QLabel(this);
     m_summary->setObjectName(QStringLiteral("classesSummary"));
     m_summary->setWordWrap(true);
@@ -70,9 +67,25 @@ void ClassesPanel::setHiddenClasses(const std::bitset<kLasClassCount>& hidden) {
     m_model->setHiddenClasses(hidden);
 }
 
+void ClassesPanel::fitColumns() {
+    // Sized here rather than by QHeaderView::ResizeToContents, which follows inserted rows but
+    // not grown counts, nor contents that changed while the dock's tab was hidden.
+    m_table->resizeColumnToContents(ClassModel::ClassColumn);
+    m_table->resizeColumnToContents(ClassModel::PointsColumn);
+}
+
+void ClassesPanel::showEvent(QShowEvent* event) {
+    QWidget::showEvent(event);
+    fitColumns();
+}
+
 void ClassesPanel::poll() {
+    const ClassCounter::Snapshot previous = m_counts;
     m_counts = m_counter.snapshot();
     m_model->setCounts(m_counts.counts);
+    if (m_counts.counts != previous.counts) {
+        fitColumns();
+    }
     const QLocale locale;
     QString text;
     if (m_counts.total == 0) {

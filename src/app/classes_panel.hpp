@@ -44,8 +44,12 @@ signals:
     // New counts were polled (the classes present may have grown).
     void countsChanged();
 
+protected:
+    void showEvent(QShowEvent* event) override;
+
 private:
     void poll();
+    void fitColumns();
 
     ClassCounter m_counter;
     ClassCounter::Snapshot m_counts;
