@@ -23,7 +23,8 @@ void main() {
         return;
     }
     g_color = vec4(pointColorOf(p.position, unpackUnorm4x8(p.color), decodeNormal(p.normal),
-                                unpackUnorm4x8(node.levelColor).rgb, node.buildAge),
+                                lasBytes(p), p.gpsTime, unpackUnorm4x8(node.levelColor).rgb,
+                                node.buildAge),
                    1.0);
     rasterize(footprint);
 }

@@ -13,7 +13,7 @@
 // the resolve pass samples them as textures, and a framebuffer clear empties them.
 layout(local_size_x = 128) in;
 
-// The page of node vertices (node_vertices.hpp: 24 bytes = 3 RG32UI texels per point), the
+// The page of node vertices (node_vertices.hpp: 32 bytes = 2 RGBA32UI texels per point), the
 // frame's draw table (DrawNode below, one RGBA32UI texel each) and, per workgroup of
 // 128 invocations, the draw-table entry (from u_nodeBase) that holds its first invocation.
 uniform highp usamplerBuffer u_pagePoints;
@@ -43,6 +43,8 @@ struct PointVertex {
     uint color;  // r, g, b, intensity bytes (r lowest)
     uint normal; // GL_INT_2_10_10_10_REV, signed normalised
     float radius;
+    uint las;    // classification, return number, number of returns, flags bytes (lowest first)
+    float gpsTime;
 };
 
 struct DrawNode {
@@ -59,11 +61,15 @@ struct Footprint {
 };
 
 PointVertex loadPoint(uint index) {
-    uvec2 a = texelFetch(u_pagePoints, int(3u * index)).xy;
-    uvec2 b = texelFetch(u_pagePoints, int(3u * index + 1u)).xy;
-    uvec2 c = texelFetch(u_pagePoints, int(3u * index + 2u)).xy;
-    return PointVertex(vec3(uintBitsToFloat(a), uintBitsToFloat(b.x)), b.y, c.x,
-                       uintBitsToFloat(c.y));
+    uvec4 a = texelFetch(u_pagePoints, int(2u * index));
+    uvec4 b = texelFetch(u_pagePoints, int(2u * index + 1u));
+    return PointVertex(uintBitsToFloat(a.xyz), a.w, b.x, uintBitsToFloat(b.y), b.z,
+                       uintBitsToFloat(b.w));
+}
+
+// The LAS bytes of a vertex as color.glsl takes them.
+uvec4 lasBytes(PointVertex p) {
+    return uvec4(p.las, p.las >> 8u, p.las >> 16u, p.las >> 24u) & 0xffu;
 }
 
 DrawNode loadDrawNode(uint index) {
@@ -93,12 +99,15 @@ vec3 decodeNormal(uint bits) {
     return max(vec3(c) / 511.0, vec3(-1.0)); // the GL 4.2 rule for signed normalised values
 }
 
-// As points.vert: false when the point is clipped (outside the clip box, behind the eye,
-// outside near/far).
+// As points.vert: false when the point is clipped (outside the clip box, of a hidden class,
+// behind the eye, outside near/far).
 bool projectPoint(PointVertex p, out Footprint footprint) {
     if (u_clipEnabled &&
         any(greaterThan(abs((u_clip * vec4(p.position, 1.0)).xyz), vec3(1.0)))) {
         return false; // outside the clip box
+    }
+    if (classHidden(p.las & 0xffu)) {
+        return false;
     }
     vec4 clip = u_viewProjection * vec4(p.position, 1.0);
     if (clip.w <= 0.0) {

@@ -4,6 +4,8 @@ layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec4 a_color;  // rgb, intensity byte in alpha (normalised)
 layout(location = 2) in vec4 a_normal; // 2_10_10_10 signed normalised; zero when unknown
 layout(location = 3) in float a_radius;
+layout(location = 4) in uvec4 a_las;    // classification, return number, returns, flags
+layout(location = 5) in float a_gpsTime; // relative to the cloud's base
 
 uniform mat4 u_view;
 uniform mat4 u_projection;
@@ -21,9 +23,11 @@ out vec3 v_viewNormal;
 out float v_pointPx;
 
 void main() {
-    if (u_clipEnabled &&
-        any(greaterThan(abs((u_clip * vec4(a_position, 1.0)).xyz), vec3(1.0)))) {
-        gl_Position = vec4(0.0, 0.0, 2.0, 1.0); // beyond the far plane: not drawn
+    if ((u_clipEnabled &&
+         any(greaterThan(abs((u_clip * vec4(a_position, 1.0)).xyz), vec3(1.0)))) ||
+        classHidden(a_las.x)) {
+        gl_Position = vec4(0.0, 0.0, 2.0, 1.0); // beyond the far plane: not drawn (clipped
+                                                 // away, or of a hidden class)
         gl_PointSize = 1.0;
         v_color = vec3(0.0);
         v_viewNormal = vec3(0.0);
@@ -38,6 +42,6 @@ void main() {
     float pointPx = clamp(2.0 * radius * u_pixelsPerUnit / depth, u_minPointPx, u_maxPointPx);
     gl_PointSize = pointPx;
     v_pointPx = pointPx;
-    v_color = pointColor(a_position, a_color, a_normal.xyz);
+    v_color = pointColor(a_position, a_color, a_normal.xyz, a_las, a_gpsTime);
     v_viewNormal = mat3(u_view) * a_normal.xyz;
 }

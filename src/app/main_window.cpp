@@ -4,6 +4,8 @@
 #include "build_panel.hpp"
 #include "builder_service.hpp"
 #include "charts_panel.hpp"
+#include "class_model.hpp"
+#include "classes_panel.hpp"
 #include "clip_panel.hpp"
 #include "cloud_view.hpp"
 #include "cut_panel.hpp"
@@ -22,8 +24,8 @@
 #include <QGuiApplication>
 #include <QImage>
 #include <QInputDialog>
-#include <QLineEdit>
 #include <QLabel>
+#include <QLineEdit>
 #include <QLocale>
 #include <QMessageBox>
 #include <QMimeData>
@@ -37,9 +39,7 @@
 
 namespace omicron {
 
-namespace {
-
-} // namespace
+namespace {} // namespace
 
 QString pickedPointText(const PickedPoint& point) {
     QString text = QStringLiteral("x %1  y %2  z %3")
@@ -54,6 +54,19 @@ QString pickedPointText(const PickedPoint& point) {
     }
     if (point.hasIntensity) {
         text += QStringLiteral(" · intensity %1").arg(point.intensity);
+    }
+    if (point.hasLas) {
+        text += QStringLiteral(" · class %1 %2")
+                    .arg(point.classification)
+                    .arg(QString::fromStdString(lasClassName(point.classification)));
+        if (point.returnNumber > 0) {
+            text += QStringLiteral(" · return %1/%2")
+                        .arg(point.returnNumber)
+                        .arg(point.numberOfReturns);
+        }
+        if (point.hasGpsTime) {
+            text += QStringLiteral(" · GPS time %1").arg(point.gpsTime, 0, 'f', 6);
+        }
     }
     return text + QStringLiteral(" · level %1").arg(point.level);
 }
@@ -164,6 +177,13 @@ void MainWindow::createDocks() {
                                      QStringLiteral("measurementsDock"), Qt::BottomDockWidgetArea);
     tabifyDockWidget(findChild<QDockWidget*>(QStringLiteral("chartsDock")), measurements);
     findChild<QDockWidget*>(QStringLiteral("chartsDock"))->raise();
+    // Tabbed with the build panel, brought to the front when the view colours by class (the
+    // legend is then what the colours mean).
+    m_classesPanel = new ClassesPanel(this);
+    QDockWidget* classes =
+        dock(m_classesPanel, tr("Classes"), QStringLiteral("classesDock"), Qt::LeftDockWidgetArea);
+    tabifyDockWidget(clipping, classes);
+    findChild<QDockWidget*>(QStringLiteral("buildDock"))->raise();
     m_ui->menuPanels->actions().at(0)->setShortcut(QKeySequence(tr("Ctrl+Shift+B")));
     m_ui->menuPanels->actions().at(1)->setShortcut(QKeySequence(tr("Ctrl+Shift+U")));
     m_ui->menuPanels->actions().at(2)->setShortcut(QKeySequence(tr("Ctrl+Shift+C")));
@@ -218,18 +238,19 @@ void MainWindow::connectActions() {
         }
         // The resolution: the view's, a multiple of it, or a print/video size.
         const QSize view = m_view->size() * m_view->devicePixelRatio();
-        const QList<QSize> sizes = {view, view * 2, view * 4, QSize(1920, 1080),
-                                    QSize(3840, 2160), QSize(7680, 4320)};
+        const QList<QSize> sizes = {
+            view, view * 2, view * 4, QSize(1920, 1080), QSize(3840, 2160), QSize(7680, 4320)};
         QStringList choices;
         for (int i = 0; i < sizes.size(); ++i) {
-            const QString size = QStringLiteral("%1 × %2").arg(sizes[i].width()).arg(sizes[i].height());
-            choices.append(i == 0 ? tr("%1 (the view)").arg(size)
+            const QString size =
+                QStringLiteral("%1 × %2").arg(sizes[i].width()).arg(sizes[i].height());
+            choices.append(i == 0  ? tr("%1 (the view)").arg(size)
                            : i < 3 ? tr("%1 (%2× the view)").arg(size).arg(i == 1 ? 2 : 4)
                                    : size);
         }
         bool ok = false;
-        const QString choice = QInputDialog::getItem(this, tr("Screenshot Resolution"),
-                                                     tr("Size of the image:"), choices, 0, false, &ok);
+        const QString choice = QInputDialog::getItem(
+            this, tr("Screenshot Resolution"), tr("Size of the image:"), choices, 0, false, &ok);
         if (!ok) {
             return;
         }
@@ -279,7 +300,9 @@ void MainWindow::connectActions() {
     }
     auto* colorModes = new QActionGroup(this);
     for (QAction* action : m_ui->menuColorMode->actions()) {
-        colorModes->addAction(action);
+        if (!action->isSeparator()) {
+            colorModes->addAction(action);
+        }
     }
     m_ui->actionColorRgb->setChecked(true);
     m_ui->actionShowCutBoundary->setChecked(true);
@@ -290,18 +313,42 @@ void MainWindow::connectActions() {
         edit(settings);
         m_view->setRenderSettings(settings);
     };
-    const std::pair<QAction*, ColorMode> colors[] = {
-        {m_ui->actionColorRgb, ColorMode::Rgb},
-        {m_ui->actionColorNormal, ColorMode::Normal},
-        {m_ui->actionColorHeight, ColorMode::Height},
-        {m_ui->actionColorIntensity, ColorMode::Intensity},
-        {m_ui->actionColorLevel, ColorMode::Level},
-        {m_ui->actionColorBuildAge, ColorMode::BuildAge}};
-    for (const auto& [action, mode] : colors) {
-        connect(action, &QAction::triggered, this, [editSettings, mode = mode] {
-            editSettings([&](RenderSettings& s) { s.color = mode; });
+    m_colorModeActions = {{m_ui->actionColorRgb, ColorMode::Rgb},
+                          {m_ui->actionColorNormal, ColorMode::Normal},
+                          {m_ui->actionColorHeight, ColorMode::Height},
+                          {m_ui->actionColorIntensity, ColorMode::Intensity},
+                          {m_ui->actionColorLevel, ColorMode::Level},
+                          {m_ui->actionColorBuildAge, ColorMode::BuildAge},
+                          {m_ui->actionColorClassification, ColorMode::Classification},
+                          {m_ui->actionColorReturnNumber, ColorMode::ReturnNumber},
+                          {m_ui->actionColorGpsTime, ColorMode::GpsTime}};
+    for (const auto& [action, mode] : m_colorModeActions) {
+        connect(action, &QAction::triggered, this, [this, mode = mode] {
+            m_userChoseColor = true; // from now on, no cloud changes it
+            m_autoColorPending = false;
+            setColorMode(mode);
         });
     }
+    // The Classes dock: its check boxes edit the view's hidden classes, which it shows.
+    connect(m_classesPanel, &ClassesPanel::classVisibilityChanged, m_view,
+            &CloudView::setClassVisible);
+    connect(m_classesPanel, &ClassesPanel::allClassesHidden, this, [this, editSettings](bool hide) {
+        editSettings([&](RenderSettings& s) {
+            for (const int classification : m_classesPanel->model()->classes()) {
+                s.hiddenClasses.set(static_cast<std::size_t>(classification), hide);
+            }
+        });
+    });
+    connect(m_view, &CloudView::renderSettingsChanged, this, [this](const RenderSettings& s) {
+        m_classesPanel->setHiddenClasses(s.hiddenClasses);
+        for (const auto& [action, mode] : m_colorModeActions) {
+            if (mode == s.color) {
+                action->setChecked(true);
+            }
+        }
+    });
+    connect(m_classesPanel, &ClassesPanel::countsChanged, this,
+            &MainWindow::colorByClassesWhenClassified);
     connect(m_ui->actionPointSizeLarger, &QAction::triggered, this, [editSettings] {
         editSettings([](RenderSettings& s) {
             s.pointSizeScale = std::min(16.0f, s.pointSizeScale * 1.25f);
@@ -356,12 +403,11 @@ void MainWindow::connectActions() {
         m_pickLabel->setText(pickedPointText(point));
         m_clipPanel->setPickedPoint(point.source);
     });
-    connect(m_clipPanel, &ClipPanel::clipChanged, this,
-            [this](const std::optional<ClipBox>& clip) {
-                RenderSettings settings = m_view->renderSettings();
-                settings.clip = clip;
-                m_view->setRenderSettings(settings);
-            });
+    connect(m_clipPanel, &ClipPanel::clipChanged, this, [this](const std::optional<ClipBox>& clip) {
+        RenderSettings settings = m_view->renderSettings();
+        settings.clip = clip;
+        m_view->setRenderSettings(settings);
+    });
     connect(m_view, &CloudView::hoverLeftCloud, m_pickLabel, &QLabel::clear);
     connect(m_view, &CloudView::frameRendered, this, [this](const FrameStats& stats) {
         m_chartsPanel->setFrame(stats);
@@ -411,8 +457,9 @@ void MainWindow::createMeasureTools() {
     tool(tr("&Polyline Length"), QStringLiteral("actionMeasurePolyline"), MeasureKind::Polyline,
          QKeySequence(), tr("Length of a polyline through picked points"));
     tool(tr("Horizontal &Area"), QStringLiteral("actionMeasureArea"), MeasureKind::Area,
-         QKeySequence(), tr("Area of the polygon through picked points, projected on the "
-                            "horizontal plane"));
+         QKeySequence(),
+         tr("Area of the polygon through picked points, projected on the "
+            "horizontal plane"));
     menu->addSeparator();
     QAction* clear = menu->addAction(tr("&Clear Measurements"));
     connect(clear, &QAction::triggered, m_view, &CloudView::clearMeasurements);
@@ -468,7 +515,7 @@ void MainWindow::connectService() {
                     const CubeTransform& cube = hierarchy->cloud().cube();
                     m_clipPanel->setCloudBounds(cube.origin, cube.origin + glm::dvec3(cube.edge));
                 }
-                m_view->setHierarchy(std::move(hierarchy));
+                showCloud(std::move(hierarchy));
             });
     connect(m_service, &BuilderService::previewChanged, this,
             [this](const PreviewSample& preview, const CubeTransform& cube) {
@@ -526,9 +573,8 @@ namespace {
 
 // Where a file's viewpoints are kept: one settings group per file path.
 QString viewpointKey(const QString& file) {
-    return QStringLiteral("viewpoints/") +
-           QString::fromLatin1(QUrl::toPercentEncoding(file.isEmpty() ? QStringLiteral("-")
-                                                                      : file));
+    return QStringLiteral("viewpoints/") + QString::fromLatin1(QUrl::toPercentEncoding(
+                                               file.isEmpty() ? QStringLiteral("-") : file));
 }
 
 } // namespace
@@ -547,9 +593,9 @@ void MainWindow::saveViewpoint(const QString& name) {
     const glm::dvec3 pivot = camera.pivot();
     QSettings settings;
     QVariantMap all = settings.value(viewpointKey(m_viewpointFile)).toMap();
-    all.insert(name.trimmed(), QVariantList{pivot.x, pivot.y, pivot.z, camera.distance(),
-                                            camera.yawRadians(), camera.pitchRadians(),
-                                            camera.orthographic()});
+    all.insert(name.trimmed(),
+               QVariantList{pivot.x, pivot.y, pivot.z, camera.distance(), camera.yawRadians(),
+                            camera.pitchRadians(), camera.orthographic()});
     settings.setValue(viewpointKey(m_viewpointFile), all);
     updateViewpointMenu();
 }
@@ -726,11 +772,10 @@ void MainWindow::applyDefaultDockSizes(QSize window) {
     // The cut panel wide enough for every column of its level table (never more than 45 % of
     // the window), the charts 45 % of the height (both rows of charts whole, with room for
     // their tick labels, under their tab bar): the view keeps the rest.
-    const int cutWidth =
-        std::min(m_cutPanel->widthForAllLevelColumns(), window.width() * 45 / 100);
+    const int cutWidth = std::min(m_cutPanel->widthForAllLevelColumns(), window.width() * 45 / 100);
     resizeDocks({findChild<QDockWidget*>(QStringLiteral("cutDock"))}, {cutWidth}, Qt::Horizontal);
-    resizeDocks({findChild<QDockWidget*>(QStringLiteral("chartsDock"))},
-                {window.height() * 9 / 20}, Qt::Vertical);
+    resizeDocks({findChild<QDockWidget*>(QStringLiteral("chartsDock"))}, {window.height() * 9 / 20},
+                Qt::Vertical);
 }
 
 void MainWindow::saveSettings() const {
@@ -813,6 +858,51 @@ void MainWindow::updateStatus() {
                        frame.pendingLoads > 0 ? tr(", %1 nodes loading").arg(frame.pendingLoads)
                                               : QString())
             : resident);
+}
+
+void MainWindow::setColorMode(ColorMode mode) {
+    RenderSettings settings = m_view->renderSettings();
+    settings.color = mode;
+    m_view->setRenderSettings(settings);
+    if (mode == ColorMode::Classification) {
+        findChild<QDockWidget*>(QStringLiteral("classesDock"))->raise(); // the legend
+    }
+}
+
+void MainWindow::showCloud(std::shared_ptr<const Hierarchy> hierarchy) {
+    const bool newCloud = hierarchy != nullptr && m_shownCloud.lock() != hierarchy->sharedCloud();
+    if (newCloud) {
+        m_shownCloud = hierarchy->sharedCloud();
+        // Classes are a property of the cloud: every class of a new one is shown.
+        RenderSettings settings = m_view->renderSettings();
+        settings.hiddenClasses.reset();
+        if (!m_userChoseColor) {
+            settings.color = ColorMode::Rgb; // until its classes say otherwise
+            m_autoColorPending = hierarchy->cloud().attributes().has(Attribute::Las);
+        }
+        m_view->setRenderSettings(settings);
+    }
+    m_classesPanel->setHierarchy(hierarchy);
+    m_view->setHierarchy(std::move(hierarchy));
+}
+
+void MainWindow::colorByClassesWhenClassified() {
+    if (!m_autoColorPending) {
+        return;
+    }
+    // Classes 0-2 (never classified, unclassified, ground) come with most scans and say little;
+    // any other class means someone classified the cloud, which is then what to look at.
+    const ClassCounter::Snapshot& counts = m_classesPanel->counts();
+    for (int classification = 3; classification < kLasClassCount; ++classification) {
+        if (counts.counts[static_cast<std::size_t>(classification)] > 0) {
+            m_autoColorPending = false;
+            setColorMode(ColorMode::Classification);
+            return;
+        }
+    }
+    if (counts.complete || counts.notCounted) {
+        m_autoColorPending = false;
+    }
 }
 
 void MainWindow::applyViewParameters(const ViewParameters& parameters) {

@@ -30,12 +30,14 @@ namespace omicron {
 class BuilderService;
 class BuildPanel;
 class ChartsPanel;
+class ClassesPanel;
 class MeasurementsPanel;
 class ClipPanel;
 class CloudView;
 class CutPanel;
 
-// The status bar's text for the point under the cursor: "x … y … z … · RGB … · level …".
+// The status bar's text for the point under the cursor: "x … y … z … · RGB … · class 2 Ground
+// · return 1/3 · GPS time … · level …".
 QString pickedPointText(const PickedPoint& point);
 
 class MainWindow : public QMainWindow {
@@ -52,6 +54,7 @@ public:
     ChartsPanel* chartsPanel() const { return m_chartsPanel; }
     MeasurementsPanel* measurementsPanel() const { return m_measurementsPanel; }
     ClipPanel* clipPanel() const { return m_clipPanel; }
+    ClassesPanel* classesPanel() const { return m_classesPanel; }
     // The central CloudView.
     CloudView* cloudView() const { return m_view; }
     QStringList recentFiles() const { return m_recentFiles; }
@@ -101,6 +104,9 @@ private:
     void updateActions();
     void updateStatus();
     void applyViewParameters(const ViewParameters& parameters);
+    void setColorMode(ColorMode mode);
+    void showCloud(std::shared_ptr<const Hierarchy> hierarchy);
+    void colorByClassesWhenClassified();
     void showShortcuts();
     void showAbout();
     QString askSavePath(const QString& title, const QString& filter, const QString& suffix);
@@ -108,6 +114,13 @@ private:
     std::unique_ptr<Ui::MainWindow> m_ui;
     // View > Render Mode: each action and the mode it selects.
     std::vector<std::pair<QAction*, RenderMode>> m_renderModeActions;
+    // View > Colour Mode: each action and the mode it selects.
+    std::vector<std::pair<QAction*, ColorMode>> m_colorModeActions;
+    // The user picked a colour mode: clouds opened later keep it. Until then a cloud opens in
+    // RGB, or in classification once its points show classes beyond 0-2 (m_autoColorPending).
+    bool m_userChoseColor = false;
+    bool m_autoColorPending = false;
+    std::weak_ptr<const SortedCloud> m_shownCloud; // a rebuild keeps it, an open replaces it
     BuilderService* m_service = nullptr;
     CloudView* m_view = nullptr;
     BuildPanel* m_buildPanel = nullptr;
@@ -115,8 +128,9 @@ private:
     ChartsPanel* m_chartsPanel = nullptr;
     MeasurementsPanel* m_measurementsPanel = nullptr;
     ClipPanel* m_clipPanel = nullptr;
+    ClassesPanel* m_classesPanel = nullptr;
     QStringList m_recentFiles;
-    QString m_title; // what is shown: file name or "generated scene"
+    QString m_title;         // what is shown: file name or "generated scene"
     QString m_viewpointFile; // whose viewpoints the menu lists (absolute path; empty: a scene)
     QMenu* m_viewpointMenu = nullptr;
     PipelineProgress m_progress;
@@ -129,7 +143,7 @@ private:
     QTimer m_statusTimer;
     std::size_t m_pointsDrawn = 0;
     FrameStats m_lastFrameStats; // the paged-points figures of the last frame
-    QElapsedTimer m_lastFrame; // since the view's last frame
+    QElapsedTimer m_lastFrame;   // since the view's last frame
 };
 
 } // namespace omicron

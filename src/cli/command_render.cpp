@@ -40,9 +40,15 @@ constexpr std::pair<const char*, RenderMode> kModes[] = {
 };
 
 constexpr std::pair<const char*, ColorMode> kColors[] = {
-    {"rgb", ColorMode::Rgb},       {"normal", ColorMode::Normal},
-    {"height", ColorMode::Height}, {"intensity", ColorMode::Intensity},
-    {"level", ColorMode::Level},   {"age", ColorMode::BuildAge},
+    {"rgb", ColorMode::Rgb},
+    {"normal", ColorMode::Normal},
+    {"height", ColorMode::Height},
+    {"intensity", ColorMode::Intensity},
+    {"level", ColorMode::Level},
+    {"age", ColorMode::BuildAge},
+    {"classification", ColorMode::Classification},
+    {"return-number", ColorMode::ReturnNumber},
+    {"gps-time", ColorMode::GpsTime},
 };
 
 QSize parseSize(const std::string& text) {
@@ -122,16 +128,17 @@ int runRender(const std::vector<std::string>& args) {
             }
         }
         if (!known) {
-            throw UsageError("--color takes rgb, normal, height, intensity, level or age, found '" +
+            throw UsageError("--color takes rgb, normal, height, intensity, level, age, "
+                             "classification, return-number or gps-time, found '" +
                              *color + "'");
         }
     }
     if (parsed.flag("edl") && parsed.flag("no-edl")) {
         throw UsageError("--edl and --no-edl contradict each other: give one");
     }
-    settings.edl = parsed.flag("edl") ? EdlMode::On
+    settings.edl = parsed.flag("edl")      ? EdlMode::On
                    : parsed.flag("no-edl") ? EdlMode::Off
-                                          : EdlMode::Auto;
+                                           : EdlMode::Auto;
     if (const auto threshold = parsed.value("threshold")) {
         settings.projectionThresholdPx =
             static_cast<double>(parseInteger(*threshold, "threshold", 1, 100000));
@@ -192,8 +199,9 @@ int runRender(const std::vector<std::string>& args) {
                     static_cast<double>(residency.budgetBytes) / (1 << 20),
                     static_cast<unsigned long long>(residency.evictions));
         if (residency.failedNodes > 0) {
-            std::fprintf(stderr, "omicron-cli: %llu nodes could not be read, their parents were "
-                                 "drawn instead; the first: %s\n",
+            std::fprintf(stderr,
+                         "omicron-cli: %llu nodes could not be read, their parents were "
+                         "drawn instead; the first: %s\n",
                          static_cast<unsigned long long>(residency.failedNodes),
                          residency.firstError.c_str());
         }
@@ -207,7 +215,8 @@ const Command& renderCommand() {
     static const Command command{
         "render", "build a cloud's hierarchy and save an image of it (needs a display)",
         "render IN OUT.png [--camera fit|iso|top|bottom|front|back|left|right] [--size WxH] "
-        "[--mode points|compute|splats] [--color rgb|normal|height|intensity|level|age] "
+        "[--mode points|compute|splats] [--color rgb|normal|height|intensity|level|age|"
+        "classification|return-number|gps-time] "
         "[--edl|--no-edl] [--depth N] "
         "[--threshold PX] [--threads T] [--memory-budget SIZE] [--temp-dir DIR]",
         "Runs the pipeline (an unsorted cloud is sorted first; a .oms file is streamed; a .omh\n"
@@ -221,7 +230,10 @@ const Command& renderCommand() {
         "             points where unavailable), points (GL points) or splats (three-pass\n"
         "             surface splatting)\n"
         "  --color    rgb (default; height where the cloud has no colour), normal, height,\n"
-        "             intensity, level (hierarchy level of each node), age (build order)\n"
+        "             intensity, level (hierarchy level of each node), age (build order),\n"
+        "             classification (ASPRS class colours), return-number (1st, 2nd, 3rd,\n"
+        "             4th and later), gps-time (a ramp over the GPS times); the LAS ones fall\n"
+        "             back to height for clouds without those fields\n"
         "  --edl, --no-edl  eye-dome lighting on or off (default: on for clouds without\n"
         "             colours, where it makes the shape readable)\n"
         "  --depth    hierarchy depth (default 7)\n"

@@ -3,12 +3,14 @@
 #include "build/hierarchy.hpp"
 #include "front/front_projection.hpp"
 #include "front/front_settle.hpp"
+#include "points/asprs_classes.hpp"
 #include "shader_library.hpp"
 #include "view_camera.hpp"
 
 #include <QElapsedTimer>
 #include <QOpenGLContext>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <glm/gtc/type_ptr.hpp>
 
@@ -38,6 +40,33 @@ glm::vec3 levelColor(int level) {
     return glm::vec3(0.25f) + table[std::clamp(sector, 0, 5)] * 0.75f;
 }
 
+// lasClassColor of every class, RGBA8 with red lowest, for color.glsl's u_classColors.
+const std::array<std::uint32_t, kLasClassCount>& classPalette() {
+    static const std::array<std::uint32_t, kLasClassCount> palette = [] {
+        std::array<std::uint32_t, kLasClassCount> packed{};
+        for (int c = 0; c < kLasClassCount; ++c) {
+            const glm::u8vec3 color = lasClassColor(c);
+            packed[static_cast<std::size_t>(c)] = std::uint32_t{color.r} |
+                                                  (std::uint32_t{color.g} << 8) |
+                                                  (std::uint32_t{color.b} << 16) | (255u << 24);
+        }
+        return packed;
+    }();
+    return palette;
+}
+
+// The hidden classes as color.glsl's u_hiddenClasses: class c is bit c % 32 of word c / 32.
+std::array<std::uint32_t, kLasClassCount / 32>
+hiddenClassWords(const std::bitset<kLasClassCount>& hidden) {
+    std::array<std::uint32_t, kLasClassCount / 32> words{};
+    for (std::size_t c = 0; c < hidden.size(); ++c) {
+        if (hidden.test(c)) {
+            words[c / 32] |= 1u << (c % 32);
+        }
+    }
+    return words;
+}
+
 } // namespace
 
 CloudNode::CloudNode() = default;
@@ -53,6 +82,8 @@ void CloudNode::setHierarchy(std::shared_ptr<const Hierarchy> hierarchy) {
     m_boundsLevel = -1;
     m_boundsMin = glm::dvec3(1.0);
     m_boundsMax = glm::dvec3(0.0);
+    m_gpsTimeBase.reset();
+    m_gpsTimes = GpsTimeRange{};
 }
 
 void CloudNode::setPreview(std::vector<PointVertex> vertices) {
@@ -192,11 +223,11 @@ void CloudNode::evaluateFront(RenderContext& context) {
         m_front->evaluate(camera, options);
     } else {
         // A screenshot: everything the threshold asks for; paged points, the nodes too.
-        pendingBefore = settleFront(*m_front, camera, options,
-                                    residency != nullptr
-                                        ? SettleLimits{INT_MAX, kMaxPagedSettleSeconds}
-                                        : SettleLimits{kMaxSettleEvaluations})
-                            .pendingBefore;
+        pendingBefore =
+            settleFront(*m_front, camera, options,
+                        residency != nullptr ? SettleLimits{INT_MAX, kMaxPagedSettleSeconds}
+                                             : SettleLimits{kMaxSettleEvaluations})
+                .pendingBefore;
     }
     if (residency != nullptr) {
         const ResidencyStats paged = residency->stats();
@@ -280,7 +311,11 @@ void CloudNode::collectDrawList(RenderContext& context) {
         for (std::size_t i = batchBegin; i < next; ++i) {
             m_packNodes.push_back(&nodeOf(*missing[i]));
         }
-        packNodesVertices(*m_hierarchy, m_packNodes, m_packed);
+        if (!m_gpsTimeBase) {
+            // Fixed for the cloud's life: uploaded vertices are relative to it.
+            m_gpsTimeBase = gpsTimeBaseOf(*m_hierarchy, *m_packNodes.front());
+        }
+        m_gpsTimes.add(packNodesVertices(*m_hierarchy, m_packNodes, m_packed, *m_gpsTimeBase));
         for (std::size_t i = 0; i < batchSize; ++i) {
             DrawItem* item = missing[batchBegin + i];
             item->buffer = &m_cache.upload(*context.gl, item->key, m_packed[i], m_frame);
@@ -312,10 +347,18 @@ bool CloudNode::hasColor() const {
 
 int CloudNode::effectiveColorMode(const RenderSettings& settings) const {
     ColorMode mode = settings.color;
+    const bool lasOnly = mode == ColorMode::Classification || mode == ColorMode::ReturnNumber ||
+                         mode == ColorMode::GpsTime;
+    if (!m_hierarchy && lasOnly) {
+        mode = ColorMode::Height; // the preview sample carries no LAS fields
+    }
     if (m_hierarchy) {
         const AttributeSet attributes = m_hierarchy->cloud().attributes();
+        const bool lasMode = mode == ColorMode::Classification || mode == ColorMode::ReturnNumber;
         if ((mode == ColorMode::Rgb && !attributes.has(Attribute::Color)) ||
-            (mode == ColorMode::Intensity && !attributes.has(Attribute::Intensity))) {
+            (mode == ColorMode::Intensity && !attributes.has(Attribute::Intensity)) ||
+            (lasMode && !attributes.has(Attribute::Las)) ||
+            (mode == ColorMode::GpsTime && !attributes.has(Attribute::GpsTime))) {
             mode = ColorMode::Height; // what Potree and CloudCompare show for plain xyz
         }
     }
@@ -342,7 +385,8 @@ void CloudNode::setCommonUniforms(QOpenGLShaderProgram& program, const RenderCon
     const bool clipped = settings.clip.has_value() && m_hierarchy != nullptr;
     program.setUniformValue("u_clipEnabled", clipped);
     if (clipped) {
-        const glm::mat4 clip = toUnitCube(*settings.clip, m_hierarchy->cloud().cube()).toBoxMatrix();
+        const glm::mat4 clip =
+            toUnitCube(*settings.clip, m_hierarchy->cloud().cube()).toBoxMatrix();
         program.setUniformValue("u_clip", QMatrix4x4(glm::value_ptr(clip)).transposed());
     }
     const float low = hasBounds() ? static_cast<float>(m_boundsMin.z) : 0.0f;
@@ -350,6 +394,19 @@ void CloudNode::setCommonUniforms(QOpenGLShaderProgram& program, const RenderCon
     program.setUniformValue("u_heightRange", QVector2D(low, high));
     program.setUniformValue("u_levelColor", QVector3D(1, 1, 1));
     program.setUniformValue("u_buildAge", 0.0f);
+    // The GPS range grows with every upload; vertices already on the GPU follow through it.
+    program.setUniformValue("u_gpsTimeRange", QVector2D(m_gpsTimes.min, m_gpsTimes.max));
+    QOpenGLExtraFunctions& gl = *context.gl;
+    const int paletteLocation = program.uniformLocation("u_classColors");
+    if (paletteLocation >= 0) {
+        gl.glUniform1uiv(paletteLocation, kLasClassCount, classPalette().data());
+    }
+    program.setUniformValue("u_classFilter", settings.hiddenClasses.any());
+    const int hiddenLocation = program.uniformLocation("u_hiddenClasses");
+    if (hiddenLocation >= 0) {
+        const auto words = hiddenClassWords(settings.hiddenClasses);
+        gl.glUniform1uiv(hiddenLocation, static_cast<GLsizei>(words.size()), words.data());
+    }
 }
 
 void CloudNode::bindVertexLayout(QOpenGLExtraFunctions& gl, unsigned vbo) {
@@ -364,6 +421,10 @@ void CloudNode::bindVertexLayout(QOpenGLExtraFunctions& gl, unsigned vbo) {
                              reinterpret_cast<void*>(16));
     gl.glEnableVertexAttribArray(3);
     gl.glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(20));
+    gl.glEnableVertexAttribArray(4); // integers (uvec4 a_las), not normalised floats
+    gl.glVertexAttribIPointer(4, 4, GL_UNSIGNED_BYTE, stride, reinterpret_cast<void*>(24));
+    gl.glEnableVertexAttribArray(5);
+    gl.glVertexAttribPointer(5, 1, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(28));
 }
 
 void CloudNode::drawItems(RenderContext& context, QOpenGLShaderProgram& program) {

@@ -14,6 +14,7 @@
 #include <QOpenGLShaderProgram>
 #include <glm/vec3.hpp>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace omicron {
@@ -101,6 +102,11 @@ private:
     std::vector<PointVertex> m_previewVertices; // waiting for upload
     unsigned m_previewVbo = 0;
     int m_previewCount = 0;
+
+    // GPS times are uploaded relative to a base taken from the first node packed, and the
+    // range of those packed so far scales the GPS-time colour ramp.
+    std::optional<double> m_gpsTimeBase;
+    GpsTimeRange m_gpsTimes;
 
     std::size_t m_boundsScanned = 0;
     int m_boundsLevel = -1; // paged: the level whose cells the bounds are

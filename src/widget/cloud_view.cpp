@@ -4,18 +4,19 @@
 #include "build/hierarchy.hpp"
 #include "cloud_node.hpp"
 #include "edl_pass.hpp"
-#include "scale_bar.hpp"
 #include "front/front_pick.hpp"
 #include "overlay_node.hpp"
+#include "points/las_fields.hpp"
+#include "scale_bar.hpp"
 #include "sort/morton_sorter.hpp"
 #include "view_camera.hpp"
 
 #include <QElapsedTimer>
-#include <QPainter>
 #include <QKeyEvent>
 #include <QMouseEvent>
 #include <QOpenGLContext>
 #include <QOpenGLFramebufferObject>
+#include <QPainter>
 #include <QSet>
 #include <QTimer>
 #include <QWheelEvent>
@@ -66,7 +67,7 @@ public:
     std::optional<Measurement> draft; // the measurement being taken
     QPoint pressPosition;
     bool releaseEndsDoubleClick = false; // the release after a double-click adds no point
-    QTimer hoverTimer; // a pick once the pointer rests
+    QTimer hoverTimer;                   // a pick once the pointer rests
     QPoint hoverPosition;
 
     CloudViewPrivate() {
@@ -174,8 +175,8 @@ public:
             // File units per pixel at the pivot (anywhere, in an orthographic view, which is
             // as high as the perspective one at the pivot).
             const double unitsPerPixel = camera.distance() /
-                                         camera.pixelsPerUnitAtUnitDistance(heightPx) *
-                                         cube.edge * (heightPx / size.height());
+                                         camera.pixelsPerUnitAtUnitDistance(heightPx) * cube.edge *
+                                         (heightPx / size.height());
             const ScaleBar bar = scaleBarFor(unitsPerPixel, size.width() / 6.0);
             if (bar.widthPx > 0.0) {
                 const QPointF right(size.width() - 16.0, size.height() - 16.0);
@@ -184,9 +185,10 @@ public:
                 painter.drawLine(left, right);
                 painter.drawLine(left, left - QPointF(0, 6));
                 painter.drawLine(right, right - QPointF(0, 6));
-                textBox(QPointF(left.x() + (bar.widthPx - metrics.horizontalAdvance(bar.label) - 8) / 2,
-                                left.y() - metrics.height() - 12),
-                        bar.label, QColor(235, 235, 235));
+                textBox(
+                    QPointF(left.x() + (bar.widthPx - metrics.horizontalAdvance(bar.label) - 8) / 2,
+                            left.y() - metrics.height() - 12),
+                    bar.label, QColor(235, 235, 235));
             }
         }
         const bool georeferenced =
@@ -194,7 +196,8 @@ public:
         if (settings.showNorthArrow && georeferenced) {
             // +y seen from the pivot, as a direction on screen.
             const auto from = toScreen(camera.pivot());
-            const auto to = toScreen(camera.pivot() + glm::dvec3(0.0, 0.05, 0.0) * camera.distance());
+            const auto to =
+                toScreen(camera.pivot() + glm::dvec3(0.0, 0.05, 0.0) * camera.distance());
             if (from && to && *from != *to) {
                 QPointF direction = *to - *from;
                 direction /= std::hypot(direction.x(), direction.y());
@@ -206,8 +209,8 @@ public:
                 painter.setPen(QPen(QColor(235, 235, 235), 2.0));
                 painter.drawLine(tail, tip);
                 painter.setBrush(QColor(235, 235, 235));
-                painter.drawPolygon(QPolygonF({tip, tip - direction * 12.0 + side,
-                                               tip - direction * 12.0 - side}));
+                painter.drawPolygon(
+                    QPolygonF({tip, tip - direction * 12.0 + side, tip - direction * 12.0 - side}));
                 painter.drawText(QRectF(tip + direction * 10.0 - QPointF(8, 8), QSizeF(16, 16)),
                                  Qt::AlignCenter, QStringLiteral("N"));
             }
@@ -279,13 +282,12 @@ public:
         }
         const double px = x0 + static_cast<double>(best % static_cast<std::size_t>(w)) + 0.5;
         const double py = y0 + static_cast<double>(best / static_cast<std::size_t>(w)) + 0.5;
-        const glm::dmat4 inverse =
-            glm::inverse(camera.projectionMatrix(static_cast<double>(widthPx) / heightPx) *
-                         camera.viewMatrix());
+        const glm::dmat4 inverse = glm::inverse(
+            camera.projectionMatrix(static_cast<double>(widthPx) / heightPx) * camera.viewMatrix());
         const auto unproject = [&](double sx, double sy) {
-            const glm::dvec4 world = inverse * glm::dvec4(sx / widthPx * 2.0 - 1.0,
-                                                          sy / heightPx * 2.0 - 1.0,
-                                                          depths[best] * 2.0 - 1.0, 1.0);
+            const glm::dvec4 world =
+                inverse * glm::dvec4(sx / widthPx * 2.0 - 1.0, sy / heightPx * 2.0 - 1.0,
+                                     depths[best] * 2.0 - 1.0, 1.0);
             return glm::dvec3(world) / world.w;
         };
         const glm::dvec3 at = unproject(px, py);
@@ -415,6 +417,20 @@ void CloudView::setRenderSettings(const RenderSettings& settings) {
     d->settings = settings;
     emit renderSettingsChanged(settings);
     update();
+}
+
+void CloudView::setClassVisible(int classification, bool visible) {
+    if (classification < 0 || classification >= kLasClassCount) {
+        return;
+    }
+    RenderSettings settings = d->settings;
+    settings.hiddenClasses.set(static_cast<std::size_t>(classification), !visible);
+    setRenderSettings(settings);
+}
+
+bool CloudView::isClassVisible(int classification) const {
+    return classification < 0 || classification >= kLasClassCount ||
+           !d->settings.hiddenClasses.test(static_cast<std::size_t>(classification));
 }
 
 ViewCamera CloudView::camera() const {
@@ -690,6 +706,20 @@ std::optional<PickedPoint> CloudView::pickCloudPoint(const QPoint& position) {
     point.color = point.hasColor ? cloud.color(drawn->cloudIndex) : glm::u8vec3(0);
     point.hasIntensity = cloud.attributes().has(Attribute::Intensity);
     point.intensity = point.hasIntensity ? cloud.intensities()[drawn->cloudIndex] : 0;
+    const AttributeSet attributes = cloud.attributes();
+    point.hasLas = attributes.has(Attribute::Las);
+    if (point.hasLas) {
+        const LasFields las = decodeLasFields(attributes, cloud.lasRecord(drawn->cloudIndex));
+        point.classification = las.classification;
+        point.returnNumber = static_cast<std::uint8_t>(las.returnNumber());
+        point.numberOfReturns = static_cast<std::uint8_t>(las.numberOfReturns());
+        point.lasFlags = las.flags;
+        point.userData = las.userData;
+        point.pointSourceId = las.pointSourceId;
+        point.scanAngleDegrees = las.scanAngleDegrees();
+        point.hasGpsTime = attributes.has(Attribute::GpsTime);
+        point.gpsTime = las.gpsTime;
+    }
     return point;
 }
 

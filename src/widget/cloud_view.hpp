@@ -40,6 +40,10 @@ public:
 
     RenderSettings renderSettings() const;
     void setRenderSettings(const RenderSettings& settings);
+    // Shows or hides the points of one ASPRS class (0-255; others are ignored) in every render
+    // mode: RenderSettings::hiddenClasses, edited (renderSettingsChanged is emitted).
+    void setClassVisible(int classification, bool visible);
+    bool isClassVisible(int classification) const;
 
     // Camera. Until the user navigates (or setCamera() is called), the view keeps framing the
     // cloud as its bounds grow during a build.

@@ -18,7 +18,7 @@ constexpr unsigned kMaxGroupsPerDimension = 65535; // what every GL 4.3 driver d
 constexpr GLuint kDepthImageUnit = 0;
 constexpr GLuint kColorImageUnit = 1;
 constexpr GLuint kEmptyDepth = 0xffffffffu;
-constexpr std::size_t kBytesPerTexel = 8; // RG32UI: a point is 3 texels
+constexpr std::size_t kBytesPerTexel = 16; // RGBA32UI: a 32-byte point is 2 texels
 
 bool disabledByEnvironment() {
     const char* value = std::getenv(ComputeRasterizer::kDisableEnvironmentVariable);
@@ -58,7 +58,9 @@ void ComputeRasterizer::initializeGL(QOpenGLContext& context) {
         return;
     }
     try {
-        auto depth = buildComputeProgram("compute_depth.comp", {"compute_points.glsl"});
+        // color.glsl in both: the depth pass drops hidden classes as the colour pass does.
+        auto depth =
+            buildComputeProgram("compute_depth.comp", {"color.glsl", "compute_points.glsl"});
         auto color =
             buildComputeProgram("compute_color.comp", {"color.glsl", "compute_points.glsl"});
         m_resolveProgram = buildShaderProgram({"fullscreen.vert", "compute_resolve.frag"});
@@ -216,7 +218,7 @@ void ComputeRasterizer::dispatchPass(QOpenGLExtraFunctions& gl, QOpenGLShaderPro
         gl.glUniform1ui(countLocation, dispatch.invocations);
         gl.glUniform1ui(nodeBaseLocation, dispatch.nodeBase);
         gl.glUniform1ui(chunkBaseLocation, dispatch.chunkBase);
-        bindBufferTexture(gl, GL_TEXTURE0, m_pageTexture, GL_RG32UI, dispatch.buffer);
+        bindBufferTexture(gl, GL_TEXTURE0, m_pageTexture, GL_RGBA32UI, dispatch.buffer);
         const GLuint groups = (dispatch.invocations + kLocalSize - 1) / kLocalSize;
         const GLuint groupsX = std::min(groups, kMaxGroupsPerDimension);
         const GLuint groupsY = (groups + groupsX - 1) / groupsX;

@@ -60,7 +60,7 @@ public:
     void initializeGL(QOpenGLContext& context);
     void release(QOpenGLExtraFunctions& gl);
     bool available() const { return m_depthProgram != nullptr; }
-    // GL_MAX_TEXTURE_BUFFER_SIZE in bytes of RG32UI texels (0 while unavailable): the largest
+    // GL_MAX_TEXTURE_BUFFER_SIZE in bytes of RGBA32UI texels (0 while unavailable): the largest
     // page it can read.
     std::size_t maxPageBytes() const { return m_maxPageBytes; }
 

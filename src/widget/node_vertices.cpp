@@ -2,6 +2,7 @@
 
 #include "build/hierarchy.hpp"
 #include "build/splat_encoding.hpp"
+#include "points/las_fields.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -30,8 +31,17 @@ std::uint32_t packNormal2101010(float x, float y, float z) {
     return packSnorm10(x) | (packSnorm10(y) << 10) | (packSnorm10(z) << 20);
 }
 
+double gpsTimeBaseOf(const Hierarchy& hierarchy, const OctreeNode& node) {
+    const SortedCloud& cloud = hierarchy.cloud();
+    const AttributeSet attributes = cloud.attributes();
+    if (!attributes.has(Attribute::GpsTime) || node.pointCount == 0) {
+        return 0.0;
+    }
+    return decodeLasFields(attributes, cloud.lasRecord(node.heldPoint(0))).gpsTime;
+}
+
 void packNodeVertices(const Hierarchy& hierarchy, const OctreeNode& node,
-                      std::vector<PointVertex>& out, NodePackScratch& scratch) {
+                      std::vector<PointVertex>& out, NodePackScratch& scratch, double gpsTimeBase) {
     const SortedCloud& cloud = hierarchy.cloud();
     hierarchy.nodeSplats(node, scratch.splats, scratch.estimate);
     const NodeSplats& splats = scratch.splats;
@@ -40,6 +50,9 @@ void packNodeVertices(const Hierarchy& hierarchy, const OctreeNode& node,
     const auto intensities = cloud.intensities();
     const bool hasColor = cloud.hasColors();
     const bool hasIntensity = !intensities.empty();
+    const AttributeSet attributes = cloud.attributes();
+    const bool hasLas = attributes.has(Attribute::Las);
+    const bool hasGpsTime = attributes.has(Attribute::GpsTime);
 
     out.resize(node.pointCount);
     for (std::uint32_t i = 0; i < node.pointCount; ++i) {
@@ -62,18 +75,38 @@ void packNodeVertices(const Hierarchy& hierarchy, const OctreeNode& node,
             estimatedNormals ? decodeOctahedral(splats.normals[i]) : inputNormals[point];
         vertex.normal = packNormal2101010(normal.x, normal.y, normal.z);
         vertex.radius = decodeRadius(splats.radii[i]) * node.splatScale;
+        if (hasLas) {
+            const LasFields las = decodeLasFields(attributes, cloud.lasRecord(point));
+            vertex.classification = las.classification;
+            vertex.returnNumber = static_cast<std::uint8_t>(las.returnNumber());
+            vertex.numberOfReturns = static_cast<std::uint8_t>(las.numberOfReturns());
+            vertex.lasFlags = las.flags;
+            if (hasGpsTime) {
+                vertex.gpsTime = static_cast<float>(las.gpsTime - gpsTimeBase);
+                scratch.gpsTimes.add(vertex.gpsTime);
+            }
+        } else {
+            vertex.classification = vertex.returnNumber = vertex.numberOfReturns = 0;
+            vertex.lasFlags = 0;
+            vertex.gpsTime = 0.0f;
+        }
     }
 }
 
-void packNodesVertices(const Hierarchy& hierarchy, std::span<const OctreeNode* const> nodes,
-                       std::vector<std::vector<PointVertex>>& out) {
+GpsTimeRange packNodesVertices(const Hierarchy& hierarchy, std::span<const OctreeNode* const> nodes,
+                               std::vector<std::vector<PointVertex>>& out, double gpsTimeBase) {
     if (out.size() < nodes.size()) {
         out.resize(nodes.size());
     }
     tbb::enumerable_thread_specific<NodePackScratch> scratch;
     tbb::parallel_for(std::size_t{0}, nodes.size(), [&](std::size_t i) {
-        packNodeVertices(hierarchy, *nodes[i], out[i], scratch.local());
+        packNodeVertices(hierarchy, *nodes[i], out[i], scratch.local(), gpsTimeBase);
     });
+    GpsTimeRange range;
+    for (const NodePackScratch& local : scratch) {
+        range.add(local.gpsTimes);
+    }
+    return range;
 }
 
 } // namespace omicron

@@ -1,11 +1,13 @@
 // Value types of the CloudView API: what to draw and how, and what a frame cost.
 #pragma once
 
+#include "points/asprs_classes.hpp"
 #include "points/clip_box.hpp"
 #include "points/morton.hpp"
 
 #include <QMetaType>
 #include <array>
+#include <bitset>
 #include <cstddef>
 #include <cstdint>
 #include <glm/vec3.hpp>
@@ -22,7 +24,19 @@ enum class RenderMode {
     ComputePoints,
 };
 
-enum class ColorMode { Rgb, Normal, Height, Intensity, Level, BuildAge };
+// Keep the numbers in sync with shaders/color.glsl. The LAS modes fall back to Height where
+// the cloud has no LAS column (Classification, ReturnNumber) or no GPS times (GpsTime).
+enum class ColorMode {
+    Rgb,
+    Normal,
+    Height,
+    Intensity,
+    Level,
+    BuildAge,
+    Classification, // ASPRS class colours (lasClassColor)
+    ReturnNumber,   // 1st, 2nd, 3rd, 4th and later returns in four colours
+    GpsTime,        // a ramp over the GPS times of the points uploaded so far
+};
 
 // Eye-dome lighting: Auto shades clouds without colours of their own (where the colour is a
 // height ramp and the shape is hard to read), as Potree does.
@@ -39,14 +53,14 @@ struct RenderSettings {
     double projectionThresholdPx = 16.0;
     // Most points drawn per frame: Mesa llvmpipe draws ~3M points/s, so 1M keeps it usable.
     std::size_t pointBudget = 1'000'000;
-    double frontBudgetMs = 2.0;            // front evaluation CPU time per frame
+    double frontBudgetMs = 2.0;                     // front evaluation CPU time per frame
     std::size_t uploadBudgetBytes = 32u << 20;      // GPU uploads per frame
     std::size_t gpuMemoryBudgetBytes = 1024u << 20; // node buffers kept on the GPU
-    bool showBoundingBox = true;   // the cloud's bounding box
-    bool showOctreeCells = false;  // wireframe of the front's node cells
-    bool showCutBoundary = true;   // highlight of the roots of the oblique cut
-    bool showAxes = true;          // axis gizmo in the corner
-    bool showScaleBar = true;      // a round length at the pivot's depth, bottom right
+    bool showBoundingBox = true;                    // the cloud's bounding box
+    bool showOctreeCells = false;                   // wireframe of the front's node cells
+    bool showCutBoundary = true;                    // highlight of the roots of the oblique cut
+    bool showAxes = true;                           // axis gizmo in the corner
+    bool showScaleBar = true; // a round length at the pivot's depth, bottom right
     // An arrow to +y (grid north) top right, for georeferenced clouds (coordinates of 10^4
     // units or more: a projected system, where +y is north).
     bool showNorthArrow = true;
@@ -56,22 +70,25 @@ struct RenderSettings {
     // Only the points inside this box (source coordinates: the file's units) are drawn, and
     // octree cells wholly outside it are culled by the front. None: everything.
     std::optional<ClipBox> clip;
+    // Points whose ASPRS class (LAS classification) is set here are not drawn, in any render
+    // mode (CloudView::setClassVisible edits it). Clouds without classes are class 0.
+    std::bitset<kLasClassCount> hiddenClasses;
     friend bool operator==(const RenderSettings&, const RenderSettings&) = default;
 };
 
 struct FrameStats {
-    double frameMs = 0.0;  // CPU time of paintGL (front, uploads, draw calls)
-    double frontMs = 0.0;  // front evaluation alone
-    double fps = 0.0;      // frames per second over the last second
+    double frameMs = 0.0; // CPU time of paintGL (front, uploads, draw calls)
+    double frontMs = 0.0; // front evaluation alone
+    double fps = 0.0;     // frames per second over the last second
     std::size_t frontNodes = 0;
     // frontNodes by level 0..morton::kMaxLevel (placeholders at their leaf's level).
     std::array<std::size_t, morton::kMaxLevel + 1> frontNodesPerLevel{};
     std::size_t placeholders = 0;
     std::size_t nodesDrawn = 0;
     std::size_t pointsDrawn = 0;
-    std::size_t pointsTotal = 0;   // points of the cloud (input)
-    std::size_t uploads = 0;       // node buffers uploaded this frame
-    std::size_t gpuBytes = 0;      // node buffers resident on the GPU
+    std::size_t pointsTotal = 0; // points of the cloud (input)
+    std::size_t uploads = 0;     // node buffers uploaded this frame
+    std::size_t gpuBytes = 0;    // node buffers resident on the GPU
     bool showingPreview = false;
     bool eyeDomeLighting = false; // the frame was shaded with EDL
     // A hierarchy whose points are paged in on demand (a .omh beyond the memory budget):
@@ -91,14 +108,25 @@ struct FrameStats {
 
 // A point of the cloud under the cursor (CloudView::pickCloudPoint): one the frame drew.
 struct PickedPoint {
-    glm::dvec3 source{0.0};      // in the file's coordinates and units (offsets included)
+    glm::dvec3 source{0.0};       // in the file's coordinates and units (offsets included)
     glm::vec3 unitPosition{0.0f}; // in the hierarchy's unit cube
-    int level = 0;               // of the node that drew it
+    int level = 0;                // of the node that drew it
     std::uint32_t cloudIndex = 0;
     bool hasColor = false;
     glm::u8vec3 color{0};
     bool hasIntensity = false;
     std::uint16_t intensity = 0;
+    // The LAS fields (points/las_fields.hpp), where the cloud has its LAS column.
+    bool hasLas = false;
+    std::uint8_t classification = 0;
+    std::uint8_t returnNumber = 0;
+    std::uint8_t numberOfReturns = 0;
+    std::uint8_t lasFlags = 0; // las_flag bits: synthetic, key-point, withheld, overlap, ...
+    std::uint8_t userData = 0;
+    std::uint16_t pointSourceId = 0;
+    double scanAngleDegrees = 0.0;
+    bool hasGpsTime = false;
+    double gpsTime = 0.0;
 };
 
 } // namespace omicron

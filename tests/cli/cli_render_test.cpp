@@ -1,9 +1,12 @@
 // omicron-cli render's eye-dome lighting: --edl and --no-edl give different images of an
 // uncoloured cloud; by default (auto) the bunny (no colours) is shaded and the lion (colours)
-// is not; both flags at once are a usage error. Needs a display (the suite runs under Xvfb).
+// is not; both flags at once are a usage error. Its LAS colour modes: --color classification
+// draws the TerraScan tile in its classes' colours. Needs a display (the suite runs under Xvfb).
+#include "points/asprs_classes.hpp"
 #include "run_process.hpp"
 #include "test_files.hpp"
 
+#include <QImage>
 #include <cstdlib>
 #include <gtest/gtest.h>
 #include <string>
@@ -47,6 +50,54 @@ TEST(CliRender, EyeDomeLightingOnOffAndAutomatic) {
     const auto both = runCli({"render", bunny, dir.file("x.png"), "--edl", "--no-edl"});
     EXPECT_EQ(both.exitCode, 2);
     EXPECT_NE(both.err.find("--edl and --no-edl"), std::string::npos) << both.err;
+}
+
+// Pixels of `image` within a few levels of `color`.
+int pixelsNear(const QImage& image, glm::u8vec3 color) {
+    const QImage rgb = image.convertToFormat(QImage::Format_RGB32);
+    int count = 0;
+    for (int y = 0; y < rgb.height(); ++y) {
+        for (int x = 0; x < rgb.width(); ++x) {
+            const QRgb p = rgb.pixel(x, y);
+            count += std::abs(qRed(p) - color.r) + std::abs(qGreen(p) - color.g) +
+                                 std::abs(qBlue(p) - color.b) <=
+                             12
+                         ? 1
+                         : 0;
+        }
+    }
+    return count;
+}
+
+TEST(CliRender, ClassificationColoursTheClasses) {
+    if (std::getenv("DISPLAY") == nullptr) {
+        GTEST_SKIP() << "no DISPLAY: omicron-cli render needs an X server (run under xvfb-run)";
+    }
+    OMICRON_REQUIRE_SHARED_FILE(tile, "laz/terrascan_fmt8.las");
+    TempDir dir;
+    const auto byClass =
+        render(tile, dir, "classes.png", {"--color", "classification", "--no-edl"});
+    const auto byRgb = render(tile, dir, "rgb.png", {"--no-edl"});
+    EXPECT_NE(byClass, byRgb);
+    QImage image;
+    ASSERT_TRUE(image.loadFromData(byClass.data(), static_cast<int>(byClass.size()), "PNG"));
+    // Mostly ground (683,023 of 697,721 points), with high vegetation (9,003) in patches.
+    EXPECT_GT(pixelsNear(image, lasClassColor(2)), 2000);
+    EXPECT_GT(pixelsNear(image, lasClassColor(5)), 10);
+    QImage rgb;
+    ASSERT_TRUE(rgb.loadFromData(byRgb.data(), static_cast<int>(byRgb.size()), "PNG"));
+    EXPECT_LT(pixelsNear(rgb, lasClassColor(2)), pixelsNear(image, lasClassColor(2)) / 10);
+    // The other LAS modes render too, each its own image.
+    const auto byReturn = render(tile, dir, "returns.png", {"--color", "return-number"});
+    const auto byGps = render(tile, dir, "gps.png", {"--color", "gps-time"});
+    EXPECT_NE(byReturn, byClass);
+    EXPECT_NE(byGps, byClass);
+    EXPECT_NE(byGps, byReturn);
+
+    const auto unknown = runCli({"render", tile, dir.file("x.png"), "--color", "classes"});
+    EXPECT_EQ(unknown.exitCode, 2);
+    EXPECT_NE(unknown.err.find("classification, return-number or gps-time"), std::string::npos)
+        << unknown.err;
 }
 
 } // namespace

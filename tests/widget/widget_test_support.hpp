@@ -41,4 +41,14 @@ double coverage(const QImage& image, const QColor& background);
 // The CloudView's clear colour.
 QColor viewBackground();
 
+// Pixels of `image` within `tolerance` (sum of the channels' differences) of `color`.
+int pixelsNear(const QImage& image, const QColor& color, int tolerance = 12);
+
+// A classified LAS 1.4 (point format 6) test cloud at `path`: a flat 40 x 40 grid of points
+// 1 m apart (x = 300000 + i, y = 5000000 + j, z = 50), class 2 (Ground) where i < 20 and
+// class 6 (Building) where i >= 20; return number j % 4 + 1 of 4; GPS time 4e8 + 10 i (a
+// ramp along x at a magnitude a float would not resolve to the second). Throws on failure.
+void writeClassifiedLas(const QString& path);
+inline constexpr int kClassifiedLasPointsPerClass = 800;
+
 } // namespace omicron::test
