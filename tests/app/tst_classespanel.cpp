@@ -114,7 +114,7 @@ private slots:
     }
 
     void sharedTerraScanTileCountsEveryClass() {
-        OMICRON_REQUIRE_SHARED_FILE(path, QStringLiteral("laz/terrascan_fmt8.las"));
+        OMICRON_REQUIRE_SHARED_FILE(path, QStringLiteral("laz/terrascan_fmt8.laz"));
         ClassesPanel panel;
         QAbstractItemModelTester tester(panel.model(),
                                         QAbstractItemModelTester::FailureReportingMode::QtTest);

@@ -63,7 +63,7 @@ private slots:
     }
 
     void aClassifiedCloudOpensColouredByClassWithItsLegend() {
-        OMICRON_REQUIRE_SHARED_FILE(path, QStringLiteral("laz/terrascan_fmt8.las"));
+        OMICRON_REQUIRE_SHARED_FILE(path, QStringLiteral("laz/terrascan_fmt8.laz"));
         MainWindow window;
         window.resize(1400, 900);
         window.show();
@@ -137,7 +137,7 @@ private slots:
 
     void aCloudOfGroundOnlyKeepsRgbAndAChosenModeIsKept() {
         OMICRON_REQUIRE_SHARED_FILE(autzen, QStringLiteral("autzen_trim.las"));
-        OMICRON_REQUIRE_SHARED_FILE(terrascan, QStringLiteral("laz/terrascan_fmt8.las"));
+        OMICRON_REQUIRE_SHARED_FILE(terrascan, QStringLiteral("laz/terrascan_fmt8.laz"));
         MainWindow window;
         window.resize(1200, 800);
         window.show();

@@ -73,7 +73,7 @@ TEST(CliRender, ClassificationColoursTheClasses) {
     if (std::getenv("DISPLAY") == nullptr) {
         GTEST_SKIP() << "no DISPLAY: omicron-cli render needs an X server (run under xvfb-run)";
     }
-    OMICRON_REQUIRE_SHARED_FILE(tile, "laz/terrascan_fmt8.las");
+    OMICRON_REQUIRE_SHARED_FILE(tile, "laz/terrascan_fmt8.laz");
     TempDir dir;
     const auto byClass =
         render(tile, dir, "classes.png", {"--color", "classification", "--no-edl"});
