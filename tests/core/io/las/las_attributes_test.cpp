@@ -6,6 +6,7 @@
 #include "io/cloud_export.hpp"
 #include "io/las/las_header.hpp"
 #include "io/las/las_point_fields.hpp"
+#include "io/las/las_writer.hpp"
 #include "io/point_reader.hpp"
 #include "points/attribute_statistics.hpp"
 #include "sort/morton_sorter.hpp"
@@ -85,6 +86,44 @@ TEST(LasFields, LegacyRecordFieldsSurviveLas14AndBack) {
     las::writeLasFields(again, 1, back.data());
     EXPECT_TRUE(std::equal(legacy.begin() + 14, legacy.end(), back.begin() + 14))
         << "the legacy fields did not read back as written";
+}
+
+// Waveform formats (4, 5, 9, 10) are read for their point part, and say so.
+TEST(LasFields, WaveformFormatsReadTheirPointsAndSayWaveformsAreIgnored) {
+    test::TempDir dir;
+    for (std::uint8_t format : {4, 5, 9, 10}) {
+        SCOPED_TRACE(static_cast<int>(format));
+        const AttributeSet attributes = las::attributesOfFormat(format, 0);
+        PointBatch batch;
+        batch.attributes = attributes;
+        for (int i = 0; i < 10; ++i) {
+            batch.positions.emplace_back(0.1f * i, 0.05f * i, 0.5f);
+            batch.intensities.push_back(static_cast<std::uint16_t>(100 + i));
+            if (attributes.has(Attribute::Color)) {
+                batch.colors.emplace_back(i, 2 * i, 3 * i);
+            }
+            LasFields fields;
+            fields.classification = static_cast<std::uint8_t>(i);
+            fields.returns = static_cast<std::uint8_t>(1 | 2 << 4);
+            fields.gpsTime = 1000.0 + i;
+            fields.pointSourceId = 7;
+            std::vector<std::uint8_t> column(attributes.lasBytes());
+            encodeLasFields(attributes, fields, column.data());
+            batch.las.insert(batch.las.end(), column.begin(), column.end());
+        }
+        LasWriteOptions options;
+        options.versionMinor = 4;
+        options.pointFormat = format;
+        const std::string path = dir.file("waveform.las");
+        writeLas(path, batch, CubeTransform::fromBounds({glm::dvec3(0.0), glm::dvec3(1.0)}),
+                 options);
+        const LoadedCloud read = loadPointCloud(path);
+        EXPECT_NE(read.info.formatDetail.find("waveform packets ignored"), std::string::npos)
+            << read.info.formatDetail;
+        ASSERT_EQ(read.points.size(), 10u);
+        EXPECT_TRUE(read.points.las == batch.las);
+        EXPECT_EQ(read.points.intensities, batch.intensities);
+    }
 }
 
 TEST(LasFields, AttributesOfEveryFormat) {
