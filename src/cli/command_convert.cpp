@@ -24,6 +24,7 @@ struct WholeCloud {
     PointBatch points;
     CubeTransform cube;
     glm::dvec3 sourceOffset{0.0};
+    std::vector<std::uint8_t> lasExtraBytesDescriptors; // of a LAS or LAZ input
 };
 
 WholeCloud readWhole(const std::string& path) {
@@ -41,6 +42,7 @@ WholeCloud readWhole(const std::string& path) {
     whole.points = std::move(loaded.points);
     whole.cube = loaded.info.cube;
     whole.sourceOffset = loaded.info.sourceOffset;
+    whole.lasExtraBytesDescriptors = std::move(loaded.info.lasExtraBytesDescriptors);
     return whole;
 }
 
@@ -50,7 +52,8 @@ WholeCloud readWhole(const std::string& path) {
 LasWriteOptions lasOptions(const WholeCloud& whole) {
     LasWriteOptions options;
     if (whole.points.attributes.has(Attribute::Las)) {
-        options = lasExportOptions(whole.points.attributes, whole.cube);
+        options = lasExportOptions(whole.points.attributes, whole.cube,
+                                   whole.lasExtraBytesDescriptors);
     }
     options.offset = whole.cube.origin;
     const double step = std::min(0.001, whole.cube.edge / double(1u << 30));

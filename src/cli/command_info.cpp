@@ -4,6 +4,7 @@
 #include "commands.hpp"
 #include "formats/omh_reader.hpp"
 #include "formats/oms_reader.hpp"
+#include "io/las/las_extra_bytes.hpp"
 #include "io/point_reader.hpp"
 #include "json_writer.hpp"
 #include "omh_info.hpp"
@@ -42,6 +43,16 @@ void printJson(const InfoReport& report) {
     json.key("attributes").beginArray();
     for (const std::string& name : attributeNames(info.attributes)) {
         json.value(name);
+    }
+    json.endArray();
+    json.key("extra_bytes").beginArray();
+    for (const las::ExtraBytesField& field :
+         las::parseExtraBytesDescriptors(info.lasExtraBytesDescriptors)) {
+        json.beginObject();
+        json.key("name").value(field.name);
+        json.key("type").value(las::extraBytesTypeName(field));
+        json.key("description").value(field.description);
+        json.endObject();
     }
     json.endArray();
     json.key("attribute_ranges").beginObject();
@@ -93,6 +104,12 @@ void printText(const InfoReport& report) {
                 static_cast<unsigned long long>(report.summary.skippedNonFinite));
     std::printf("attributes:  %s\n",
                 attributes.empty() ? "none (positions only)" : attributes.c_str());
+    for (const las::ExtraBytesField& field :
+         las::parseExtraBytesDescriptors(info.lasExtraBytesDescriptors)) {
+        std::printf("  extra bytes: %s (%s)%s%s\n", field.name.c_str(),
+                    las::extraBytesTypeName(field).c_str(), field.description.empty() ? "" : ": ",
+                    field.description.c_str());
+    }
     for (const NamedRange& range : report.statistics.ranges()) {
         std::printf("  %-22s %.12g .. %.12g\n", range.name.c_str(), range.range.min,
                     range.range.max);

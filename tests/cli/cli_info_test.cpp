@@ -131,6 +131,8 @@ TEST(CliInfo, ListsEveryLasAttributeWithItsRangeAndTheClasses) {
           "user data, point source id, scanner channel, scan direction, edge of flight line, "
           "gps time, nir, extra bytes (3)",
           "  return number          1 .. 6", "  point source id        47 .. 47",
+          "  extra bytes: Deviation (uint16): Pulse shape deviation",
+          "  extra bytes: confidence (uint8): confidence values",
           "  class   2 Ground                   683023 points",
           "  class  65 User 65                  10 points"}) {
         EXPECT_NE(text.out.find(line), std::string::npos) << line << "\n" << text.out;

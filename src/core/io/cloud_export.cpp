@@ -1,6 +1,8 @@
 #include "io/cloud_export.hpp"
 
 #include "io/atomic_file_writer.hpp"
+#include "io/las/las_extra_bytes.hpp"
+#include "io/las/las_header.hpp"
 #include "io/las/las_writer.hpp"
 #include "io/ply/ply_writer.hpp"
 
@@ -91,12 +93,14 @@ std::uint64_t exportCloudPoints(const std::string& path, const SortedCloud& clou
         writePly(path, points, cloud.cube(), options);
         return points.size();
     }
-    const LasWriteOptions options = lasExportOptions(cloud.attributes(), cloud.cube());
+    const LasWriteOptions options =
+        lasExportOptions(cloud.attributes(), cloud.cube(), cloud.lasExtraBytesDescriptors());
     writeLas(path, points, cloud.cube(), options);
     return points.size();
 }
 
-LasWriteOptions lasExportOptions(AttributeSet attributes, const CubeTransform& cube) {
+LasWriteOptions lasExportOptions(AttributeSet attributes, const CubeTransform& cube,
+                                 const std::vector<std::uint8_t>& extraBytesDescriptors) {
     LasWriteOptions options;
     const bool color = attributes.has(Attribute::Color);
     if (attributes.has(Attribute::Las)) {
@@ -104,7 +108,10 @@ LasWriteOptions lasExportOptions(AttributeSet attributes, const CubeTransform& c
         options.versionMinor = 4;
         options.pointFormat = attributes.has(Attribute::Nir) ? 8 : color ? 7 : 6;
         options.extraBytesPerRecord = attributes.extraBytes();
-        if (attributes.extraBytes() != 0) {
+        if (las::describesExtraBytes(extraBytesDescriptors, attributes.extraBytes())) {
+            options.vlrs.push_back({"LASF_Spec", las::kExtraBytesRecordId, "Extra Bytes Record",
+                                    extraBytesDescriptors});
+        } else if (attributes.extraBytes() != 0) {
             options.vlrs.push_back(undocumentedExtraBytesRecord(attributes.extraBytes()));
         }
     } else {

@@ -22,8 +22,10 @@ std::uint64_t exportCloudPoints(const std::string& path, const SortedCloud& clou
 
 // How a cloud is written as LAS: a cloud read from LAS or LAZ (Attribute::Las) as LAS 1.4
 // point format 6, 7 (colour) or 8 (colour and NIR) with every LAS field and its extra bytes
-// (described by an Extra Bytes record); any other as LAS 1.2 format 2 or 0 (with or without
+// (described by an Extra Bytes record: the source's `extraBytesDescriptors` when they describe
+// them, else as undocumented bytes); any other as LAS 1.2 format 2 or 0 (with or without
 // colour). Integers relative to the cube's corner at a power-of-ten step.
-LasWriteOptions lasExportOptions(AttributeSet attributes, const CubeTransform& cube);
+LasWriteOptions lasExportOptions(AttributeSet attributes, const CubeTransform& cube,
+                                 const std::vector<std::uint8_t>& extraBytesDescriptors = {});
 
 } // namespace omicron

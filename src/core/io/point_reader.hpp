@@ -19,6 +19,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace omicron {
 
@@ -37,6 +38,9 @@ struct CloudInfo {
     bool boundsFromHeader = false;  // false: from the pre-pass (or OpenOptions::knownBounds)
     glm::dvec3 sourceOffset{0.0};   // PLY "comment offset", LAS header offset
     CubeTransform cube;             // batch positions (unit cube) -> source units
+    // LAS/LAZ: the Extra Bytes descriptors (io/las/las_extra_bytes.hpp) of the extra bytes in
+    // the LAS column, when the file's describe exactly those bytes; empty otherwise.
+    std::vector<std::uint8_t> lasExtraBytesDescriptors;
 };
 
 struct OpenOptions {

@@ -123,6 +123,12 @@ public:
     const std::uint8_t* lasRecord(std::size_t i) const {
         return m_las.data() + i * m_attributes.lasBytes();
     }
+    // What the LAS column's extra bytes are (the source's Extra Bytes descriptors, 192 bytes
+    // each), for a LAS export; empty when unknown. Set by the producer before it publishes.
+    const std::vector<std::uint8_t>& lasExtraBytesDescriptors() const { return m_extraBytesDescriptors; }
+    void setLasExtraBytesDescriptors(std::vector<std::uint8_t> descriptors) {
+        m_extraBytesDescriptors = std::move(descriptors);
+    }
 
     // Producer side. The exact store is written in place, beyond sortedEnd(), then published:
     std::span<glm::vec3> mutablePositions() { return m_positions; }
@@ -187,6 +193,7 @@ private:
     HugePageArray<glm::u8vec3> m_colors;
     HugePageArray<std::uint16_t> m_intensities;
     HugePageArray<std::uint8_t> m_las;
+    std::vector<std::uint8_t> m_extraBytesDescriptors;
     HugePageArray<morton::Code> m_blockCodes;    // CloudOrder::Morton only
     std::unique_ptr<PackedPointStore> m_packed; // Packed storage only
     std::vector<glm::vec3> m_stagedPositions;   // Packed: the range stage() handed out

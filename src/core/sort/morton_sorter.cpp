@@ -97,6 +97,7 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
     // spills: its in-memory peak is over twice the cloud).
     m_cloud = makeSortedCloud(info.cube, info.sourceOffset, info.attributes, capacity,
                               m_options.storage, budget, m_options.tempDir);
+    m_cloud->setLasExtraBytesDescriptors(info.lasExtraBytesDescriptors);
     m_input.attributes = info.attributes;
     if (spills) {
         return;

@@ -171,11 +171,20 @@ private:
             const char* userId = reinterpret_cast<const char*>(&vlr[2]);
             const std::uint16_t recordId = loadRaw<std::uint16_t>(&vlr[18]);
             const std::uint16_t length = loadRaw<std::uint16_t>(&vlr[20]);
-            if (recordId == kLaszipRecordId && std::strncmp(userId, "laszip encoded", 16) == 0) {
+            if (recordId == kLaszipRecordId && std::strncmp(userId, "laszip encoded", 16) == 0 &&
+                m_header.laszipRecordOffset == 0) {
                 m_header.compressed = true;
                 m_header.laszipRecordOffset = position + kVlrHeaderSize;
                 m_header.laszipRecordLength = length;
-                return;
+            }
+            const bool extraBytes = recordId == kExtraBytesRecordId &&
+                                    std::strncmp(userId, "LASF_Spec", 16) == 0 &&
+                                    position + kVlrHeaderSize + length <= m_header.pointDataOffset;
+            if (extraBytes) {
+                const std::size_t at = m_header.extraBytesDescriptors.size();
+                m_header.extraBytesDescriptors.resize(at + length);
+                m_stream.readExact(m_header.extraBytesDescriptors.data() + at, length,
+                                   "an Extra Bytes record");
             }
             position += kVlrHeaderSize + length;
         }

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <glm/vec3.hpp>
+#include <vector>
 
 namespace omicron::las {
 
@@ -47,6 +48,7 @@ inline constexpr std::uint8_t kMaxPointFormat = 10;
 // description char[32].
 inline constexpr std::size_t kVlrHeaderSize = 54;
 inline constexpr std::uint16_t kLaszipRecordId = 22204; // user id "laszip encoded"
+inline constexpr std::uint16_t kExtraBytesRecordId = 4;  // user id "LASF_Spec"
 
 // Offsets inside a point record shared by every format.
 inline constexpr std::size_t kRecordIntensity = 12; // after int32 X, Y, Z
@@ -81,6 +83,9 @@ struct Header {
     bool compressed = false;
     std::uint64_t laszipRecordOffset = 0; // byte of the record's payload (compressed only)
     std::uint16_t laszipRecordLength = 0; // payload bytes
+    // The 192-byte descriptors of the LASF_Spec Extra Bytes records (id 4), in file order (a
+    // writer may split them over several records): names and types of the extra bytes.
+    std::vector<std::uint8_t> extraBytesDescriptors;
 
     // True when the declared bounds are finite with min <= max on every axis.
     bool hasUsableBounds() const;

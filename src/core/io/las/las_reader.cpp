@@ -3,6 +3,7 @@
 #include "io/file_stream.hpp"
 #include "io/input_error.hpp"
 #include "io/las/las_file_records.hpp"
+#include "io/las/las_extra_bytes.hpp"
 #include "io/las/las_header.hpp"
 #include "io/las/las_point_fields.hpp"
 #include "io/laz/laz_records.hpp"
@@ -47,6 +48,10 @@ public:
         m_info.pointCount = m_header.pointCount;
         m_info.sourceOffset = m_header.offset;
         m_info.attributes = las::attributesOfFormat(m_header.pointFormat, m_header.recordLength);
+        if (las::describesExtraBytes(m_header.extraBytesDescriptors,
+                                     m_info.attributes.extraBytes())) {
+            m_info.lasExtraBytesDescriptors = m_header.extraBytesDescriptors;
+        }
         if (las::formatHasColor(m_header.pointFormat)) {
             m_colorOffset = las::colorOffset(m_header.pointFormat);
             m_colorDepth = sampleColorDepth();

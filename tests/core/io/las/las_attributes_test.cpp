@@ -4,6 +4,7 @@
 #include "formats/oms_reader.hpp"
 #include "formats/oms_writer.hpp"
 #include "io/cloud_export.hpp"
+#include "io/las/las_extra_bytes.hpp"
 #include "io/las/las_header.hpp"
 #include "io/las/las_point_fields.hpp"
 #include "io/las/las_writer.hpp"
@@ -196,6 +197,9 @@ TEST_P(LasAttributesEndToEnd, SortOmsAndLasExportKeepEveryFieldByteForByte) {
     EXPECT_NE(exported.info.formatDetail.find("LAS 1.4"), std::string::npos)
         << exported.info.formatDetail;
     ASSERT_EQ(exported.info.attributes.extraBytes(), attributes.extraBytes());
+    // The extra bytes keep their names and types: the source's descriptors are written back.
+    EXPECT_TRUE(exported.info.lasExtraBytesDescriptors == original.info.lasExtraBytesDescriptors);
+    EXPECT_EQ(original.info.lasExtraBytesDescriptors.empty(), attributes.extraBytes() == 0);
     EXPECT_EQ(exported.info.attributes.has(Attribute::Nir), attributes.has(Attribute::Nir));
     ASSERT_EQ(exported.points.size(), sorted->sortedEnd());
     // A format without GPS time (0, 2) exports its zero GPS time: compare the common fields.
@@ -220,6 +224,31 @@ INSTANTIATE_TEST_SUITE_P(SharedData, LasAttributesEndToEnd,
                          ::testing::Values("autzen_trim.las", "laz/terrascan_fmt8.laz",
                                            "laz/1.2-with-color.copc.laz"),
                          test::FileParamName());
+
+// terrascan_fmt8 splits its descriptors over two Extra Bytes records, as TerraScan writes them.
+TEST(LasAttributes, ExtraBytesDescriptorsNameTheFields) {
+    OMICRON_REQUIRE_SHARED_FILE(path, "laz/terrascan_fmt8.laz");
+    const CloudInfo info = openPointCloud(path)->info();
+    ASSERT_EQ(info.lasExtraBytesDescriptors.size(), 2 * las::kExtraBytesDescriptorBytes);
+    const auto fields = las::parseExtraBytesDescriptors(info.lasExtraBytesDescriptors);
+    ASSERT_EQ(fields.size(), 2u);
+    EXPECT_EQ(fields[0].name, "Deviation");
+    EXPECT_EQ(las::extraBytesTypeName(fields[0]), "uint16");
+    EXPECT_EQ(fields[0].description, "Pulse shape deviation");
+    EXPECT_EQ(fields[1].name, "confidence");
+    EXPECT_EQ(las::extraBytesTypeName(fields[1]), "uint8");
+    EXPECT_TRUE(las::describesExtraBytes(info.lasExtraBytesDescriptors, 3));
+    EXPECT_FALSE(las::describesExtraBytes(info.lasExtraBytesDescriptors, 4))
+        << "descriptors of other bytes than the records hold must not be written back";
+    // Without descriptors (or with wrong ones), an export describes the bytes as undocumented.
+    const LasWriteOptions options =
+        lasExportOptions(info.attributes, info.cube, std::vector<std::uint8_t>(192, 0));
+    ASSERT_EQ(options.vlrs.size(), 1u);
+    const auto undocumented = las::parseExtraBytesDescriptors(options.vlrs[0].payload);
+    ASSERT_EQ(undocumented.size(), 1u);
+    EXPECT_EQ(undocumented[0].dataType, 0);
+    EXPECT_EQ(undocumented[0].bytes, 3u);
+}
 
 TEST(LasAttributes, LazColumnEqualsItsUncompressedTwin) {
     OMICRON_REQUIRE_SHARED_FILE(laz, "laz/terrascan_fmt8.laz");
