@@ -25,6 +25,7 @@ struct WholeCloud {
     CubeTransform cube;
     glm::dvec3 sourceOffset{0.0};
     std::vector<std::uint8_t> lasExtraBytesDescriptors; // of a LAS or LAZ input
+    std::vector<std::uint8_t> lasProjectionRecords;
 };
 
 WholeCloud readWhole(const std::string& path) {
@@ -43,6 +44,7 @@ WholeCloud readWhole(const std::string& path) {
     whole.cube = loaded.info.cube;
     whole.sourceOffset = loaded.info.sourceOffset;
     whole.lasExtraBytesDescriptors = std::move(loaded.info.lasExtraBytesDescriptors);
+    whole.lasProjectionRecords = std::move(loaded.info.lasProjectionRecords);
     return whole;
 }
 
@@ -53,7 +55,7 @@ LasWriteOptions lasOptions(const WholeCloud& whole) {
     LasWriteOptions options;
     if (whole.points.attributes.has(Attribute::Las)) {
         options = lasExportOptions(whole.points.attributes, whole.cube,
-                                   whole.lasExtraBytesDescriptors);
+                                   whole.lasExtraBytesDescriptors, whole.lasProjectionRecords);
     }
     options.offset = whole.cube.origin;
     const double step = std::min(0.001, whole.cube.edge / double(1u << 30));

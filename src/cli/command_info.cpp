@@ -5,17 +5,36 @@
 #include "formats/omh_reader.hpp"
 #include "formats/oms_reader.hpp"
 #include "io/las/las_extra_bytes.hpp"
+#include "io/las/las_writer.hpp"
 #include "io/point_reader.hpp"
 #include "json_writer.hpp"
 #include "omh_info.hpp"
 #include "points/attribute_statistics.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 
 namespace omicron::cli {
 
 namespace {
+
+// The coordinate system a LAS file declares: its WKT (record 2112), else "GeoTIFF keys"
+// (record 34735), else "".
+std::string coordinateSystem(const CloudInfo& info) {
+    std::string found;
+    for (const LasVariableLengthRecord& record :
+         parseVariableLengthRecords(info.lasProjectionRecords)) {
+        if (record.recordId == 2112) {
+            const auto* text = reinterpret_cast<const char*>(record.payload.data());
+            return std::string(text, std::find(text, text + record.payload.size(), '\0'));
+        }
+        if (record.recordId == 34735) {
+            found = "GeoTIFF keys";
+        }
+    }
+    return found;
+}
 
 struct InfoReport {
     std::string formatName; // "PLY binary little-endian", "OMS sorted stream", ...
@@ -77,6 +96,7 @@ void printJson(const InfoReport& report) {
     writeVector(json, info.sourceBounds.max);
     json.endObject();
     json.key("bounds_from_header").value(info.boundsFromHeader);
+    json.key("coordinate_system").value(coordinateSystem(info));
     json.key("offset");
     writeVector(json, info.sourceOffset);
     json.key("cube").beginObject();
@@ -124,6 +144,12 @@ void printText(const InfoReport& report) {
     std::printf("bounds min:  %.6f %.6f %.6f\n", b.min.x, b.min.y, b.min.z);
     std::printf("bounds max:  %.6f %.6f %.6f  (source units, %s)\n", b.max.x, b.max.y, b.max.z,
                 info.boundsFromHeader ? "from the header" : "from the points");
+    const std::string crs = coordinateSystem(info);
+    if (!crs.empty()) {
+        // A WKT runs to kilobytes: its start names the system.
+        std::printf("coordinates: %s%s\n", crs.substr(0, 100).c_str(),
+                    crs.size() > 100 ? "..." : "");
+    }
     std::printf("offset:      %.6f %.6f %.6f\n", info.sourceOffset.x, info.sourceOffset.y,
                 info.sourceOffset.z);
     std::printf("cube:        origin %.6f %.6f %.6f, edge %.6f\n", info.cube.origin.x,

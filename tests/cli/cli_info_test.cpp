@@ -133,6 +133,7 @@ TEST(CliInfo, ListsEveryLasAttributeWithItsRangeAndTheClasses) {
           "  return number          1 .. 6", "  point source id        47 .. 47",
           "  extra bytes: Deviation (uint16): Pulse shape deviation",
           "  extra bytes: confidence (uint8): confidence values",
+          "coordinates: PROJCRS[\"RGF93 / Lambert-93\"",
           "  class   2 Ground                   683023 points",
           "  class  65 User 65                  10 points"}) {
         EXPECT_NE(text.out.find(line), std::string::npos) << line << "\n" << text.out;

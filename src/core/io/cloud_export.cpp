@@ -94,14 +94,17 @@ std::uint64_t exportCloudPoints(const std::string& path, const SortedCloud& clou
         return points.size();
     }
     const LasWriteOptions options =
-        lasExportOptions(cloud.attributes(), cloud.cube(), cloud.lasExtraBytesDescriptors());
+        lasExportOptions(cloud.attributes(), cloud.cube(), cloud.lasExtraBytesDescriptors(),
+                         cloud.lasProjectionRecords());
     writeLas(path, points, cloud.cube(), options);
     return points.size();
 }
 
 LasWriteOptions lasExportOptions(AttributeSet attributes, const CubeTransform& cube,
-                                 const std::vector<std::uint8_t>& extraBytesDescriptors) {
+                                 const std::vector<std::uint8_t>& extraBytesDescriptors,
+                                 const std::vector<std::uint8_t>& projectionRecords) {
     LasWriteOptions options;
+    options.vlrs = parseVariableLengthRecords(projectionRecords);
     const bool color = attributes.has(Attribute::Color);
     if (attributes.has(Attribute::Las)) {
         // Every LAS field back: LAS 1.4's formats keep full classes, scan angles and NIR.

@@ -25,7 +25,10 @@ std::uint64_t exportCloudPoints(const std::string& path, const SortedCloud& clou
 // (described by an Extra Bytes record: the source's `extraBytesDescriptors` when they describe
 // them, else as undocumented bytes); any other as LAS 1.2 format 2 or 0 (with or without
 // colour). Integers relative to the cube's corner at a power-of-ten step.
+// The source's coordinate system records (`projectionRecords`, as CloudInfo has them) go
+// first, so the file keeps its georeference.
 LasWriteOptions lasExportOptions(AttributeSet attributes, const CubeTransform& cube,
-                                 const std::vector<std::uint8_t>& extraBytesDescriptors = {});
+                                 const std::vector<std::uint8_t>& extraBytesDescriptors = {},
+                                 const std::vector<std::uint8_t>& projectionRecords = {});
 
 } // namespace omicron

@@ -41,6 +41,9 @@ struct CloudInfo {
     // LAS/LAZ: the Extra Bytes descriptors (io/las/las_extra_bytes.hpp) of the extra bytes in
     // the LAS column, when the file's describe exactly those bytes; empty otherwise.
     std::vector<std::uint8_t> lasExtraBytesDescriptors;
+    // LAS/LAZ: the coordinate system's variable length records as the file stores them
+    // (header and payload each, concatenated); empty when it has none.
+    std::vector<std::uint8_t> lasProjectionRecords;
 };
 
 struct OpenOptions {

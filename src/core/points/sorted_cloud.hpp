@@ -129,6 +129,12 @@ public:
     void setLasExtraBytesDescriptors(std::vector<std::uint8_t> descriptors) {
         m_extraBytesDescriptors = std::move(descriptors);
     }
+    // The source's coordinate system as LAS variable length records (CloudInfo's), for a LAS
+    // export; empty when unknown. Set by the producer before it publishes.
+    const std::vector<std::uint8_t>& lasProjectionRecords() const { return m_projectionRecords; }
+    void setLasProjectionRecords(std::vector<std::uint8_t> records) {
+        m_projectionRecords = std::move(records);
+    }
 
     // Producer side. The exact store is written in place, beyond sortedEnd(), then published:
     std::span<glm::vec3> mutablePositions() { return m_positions; }
@@ -194,6 +200,7 @@ private:
     HugePageArray<std::uint16_t> m_intensities;
     HugePageArray<std::uint8_t> m_las;
     std::vector<std::uint8_t> m_extraBytesDescriptors;
+    std::vector<std::uint8_t> m_projectionRecords;
     HugePageArray<morton::Code> m_blockCodes;    // CloudOrder::Morton only
     std::unique_ptr<PackedPointStore> m_packed; // Packed storage only
     std::vector<glm::vec3> m_stagedPositions;   // Packed: the range stage() handed out

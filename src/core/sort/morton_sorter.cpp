@@ -98,6 +98,7 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
     m_cloud = makeSortedCloud(info.cube, info.sourceOffset, info.attributes, capacity,
                               m_options.storage, budget, m_options.tempDir);
     m_cloud->setLasExtraBytesDescriptors(info.lasExtraBytesDescriptors);
+    m_cloud->setLasProjectionRecords(info.lasProjectionRecords);
     m_input.attributes = info.attributes;
     if (spills) {
         return;

@@ -180,6 +180,15 @@ private:
             const bool extraBytes = recordId == kExtraBytesRecordId &&
                                     std::strncmp(userId, "LASF_Spec", 16) == 0 &&
                                     position + kVlrHeaderSize + length <= m_header.pointDataOffset;
+            const bool projection = std::strncmp(userId, "LASF_Projection", 16) == 0 &&
+                                    position + kVlrHeaderSize + length <= m_header.pointDataOffset;
+            if (projection) {
+                const std::size_t at = m_header.projectionRecords.size();
+                m_header.projectionRecords.resize(at + kVlrHeaderSize + length);
+                std::memcpy(m_header.projectionRecords.data() + at, vlr.data(), kVlrHeaderSize);
+                m_stream.readExact(m_header.projectionRecords.data() + at + kVlrHeaderSize, length,
+                                   "a coordinate system record");
+            }
             if (extraBytes) {
                 const std::size_t at = m_header.extraBytesDescriptors.size();
                 m_header.extraBytesDescriptors.resize(at + length);

@@ -86,6 +86,9 @@ struct Header {
     // The 192-byte descriptors of the LASF_Spec Extra Bytes records (id 4), in file order (a
     // writer may split them over several records): names and types of the extra bytes.
     std::vector<std::uint8_t> extraBytesDescriptors;
+    // The coordinate system's records (user id "LASF_Projection": GeoTIFF keys, WKT), each as
+    // the file stores it (its 54-byte header, then its payload), concatenated.
+    std::vector<std::uint8_t> projectionRecords;
 
     // True when the declared bounds are finite with min <= max on every axis.
     bool hasUsableBounds() const;

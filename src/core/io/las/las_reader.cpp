@@ -52,6 +52,7 @@ public:
                                      m_info.attributes.extraBytes())) {
             m_info.lasExtraBytesDescriptors = m_header.extraBytesDescriptors;
         }
+        m_info.lasProjectionRecords = m_header.projectionRecords;
         if (las::formatHasColor(m_header.pointFormat)) {
             m_colorOffset = las::colorOffset(m_header.pointFormat);
             m_colorDepth = sampleColorDepth();

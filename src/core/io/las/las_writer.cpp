@@ -250,6 +250,31 @@ void LasStreamWriter::finish() {
     m_file->commit();
 }
 
+std::vector<LasVariableLengthRecord> parseVariableLengthRecords(
+    const std::vector<std::uint8_t>& stored) {
+    std::vector<LasVariableLengthRecord> records;
+    const auto text = [](const std::uint8_t* bytes, std::size_t capacity) {
+        const auto* begin = reinterpret_cast<const char*>(bytes);
+        return std::string(begin, std::find(begin, begin + capacity, '\0'));
+    };
+    for (std::size_t at = 0; at + las::kVlrHeaderSize <= stored.size();) {
+        const std::uint8_t* header = stored.data() + at;
+        const auto length = loadRaw<std::uint16_t>(header + 20);
+        if (at + las::kVlrHeaderSize + length > stored.size()) {
+            break;
+        }
+        LasVariableLengthRecord record;
+        record.userId = text(header + 2, 16);
+        record.recordId = loadRaw<std::uint16_t>(header + 18);
+        record.description = text(header + 22, 32);
+        record.payload.assign(header + las::kVlrHeaderSize,
+                              header + las::kVlrHeaderSize + length);
+        records.push_back(std::move(record));
+        at += las::kVlrHeaderSize + length;
+    }
+    return records;
+}
+
 LasVariableLengthRecord undocumentedExtraBytesRecord(std::uint16_t count) {
     // One 192-byte descriptor per run of up to 255 bytes: reserved[2], data type, options
     // (the byte count for type 0), name[32], then limits, scales and a description.

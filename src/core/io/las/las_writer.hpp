@@ -35,6 +35,11 @@ struct LasWriteOptions {
     std::vector<LasVariableLengthRecord> vlrs;
 };
 
+// Variable length records stored as a LAS file stores them (a 54-byte header, then the
+// payload; concatenated), as records to write. A truncated tail is left out.
+std::vector<LasVariableLengthRecord> parseVariableLengthRecords(
+    const std::vector<std::uint8_t>& stored);
+
 // The LASF_Spec Extra Bytes record (id 4) describing `count` extra bytes per point as
 // undocumented bytes (data type 0), so a LAS 1.4 reader knows their length.
 LasVariableLengthRecord undocumentedExtraBytesRecord(std::uint16_t count);

@@ -200,6 +200,16 @@ TEST_P(LasAttributesEndToEnd, SortOmsAndLasExportKeepEveryFieldByteForByte) {
     // The extra bytes keep their names and types: the source's descriptors are written back.
     EXPECT_TRUE(exported.info.lasExtraBytesDescriptors == original.info.lasExtraBytesDescriptors);
     EXPECT_EQ(original.info.lasExtraBytesDescriptors.empty(), attributes.extraBytes() == 0);
+    // And its coordinate system (the shared files all have one: WKT, GeoTIFF keys).
+    const auto sourceCrs = parseVariableLengthRecords(original.info.lasProjectionRecords);
+    const auto exportedCrs = parseVariableLengthRecords(exported.info.lasProjectionRecords);
+    EXPECT_FALSE(sourceCrs.empty());
+    ASSERT_EQ(exportedCrs.size(), sourceCrs.size());
+    for (std::size_t r = 0; r < sourceCrs.size(); ++r) {
+        EXPECT_EQ(exportedCrs[r].userId, "LASF_Projection");
+        EXPECT_EQ(exportedCrs[r].recordId, sourceCrs[r].recordId);
+        EXPECT_TRUE(exportedCrs[r].payload == sourceCrs[r].payload) << "record " << r;
+    }
     EXPECT_EQ(exported.info.attributes.has(Attribute::Nir), attributes.has(Attribute::Nir));
     ASSERT_EQ(exported.points.size(), sorted->sortedEnd());
     // A format without GPS time (0, 2) exports its zero GPS time: compare the common fields.
