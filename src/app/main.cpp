@@ -1,20 +1,16 @@
 // omicron: the desktop application. `omicron [FILE]` opens FILE (PLY, LAS, XYZ, .oms, .omh);
 // without one it shows the built-in generated scene, so the program shows something at once.
+#include "cloud_view.hpp"
 #include "main_window.hpp"
 
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QIcon>
-#include <QSurfaceFormat>
 #include <cstdlib>
 
 int main(int argc, char* argv[]) {
     // CloudView needs a core profile context; it must be the default before the first widget.
-    QSurfaceFormat format;
-    format.setVersion(4, 5);
-    format.setProfile(QSurfaceFormat::CoreProfile);
-    format.setDepthBufferSize(24);
-    QSurfaceFormat::setDefaultFormat(format);
+    omicron::useCoreProfileByDefault();
 
     QApplication app(argc, argv);
     QApplication::setOrganizationName(QStringLiteral("omicron"));

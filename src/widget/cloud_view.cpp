@@ -304,6 +304,14 @@ public:
     }
 };
 
+void useCoreProfileByDefault() {
+    QSurfaceFormat format;
+    format.setVersion(4, 5);
+    format.setProfile(QSurfaceFormat::CoreProfile);
+    format.setDepthBufferSize(24);
+    QSurfaceFormat::setDefaultFormat(format);
+}
+
 CloudView::CloudView(QWidget* parent)
     : QOpenGLWidget(parent), d(std::make_unique<CloudViewPrivate>()) {
     qRegisterMetaType<omicron::FrameStats>();

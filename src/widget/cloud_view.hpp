@@ -23,6 +23,11 @@ struct PreviewSample;
 struct CubeTransform;
 class CloudViewPrivate;
 
+// Makes an OpenGL 4.5 core profile with a 24-bit depth buffer the default surface format, so
+// every context of the application (the views' and those sharing with them) can run the
+// compute rasterizer. Call before the QApplication's first window.
+void useCoreProfileByDefault();
+
 class CloudView : public QOpenGLWidget {
     Q_OBJECT
 public:

@@ -37,7 +37,6 @@
 #include <QSpinBox>
 #include <QTableWidget>
 #include <QStandardPaths>
-#include <QSurfaceFormat>
 #include <QTemporaryDir>
 #include <QTreeView>
 #include <QtTest>
@@ -536,11 +535,7 @@ void TestMainWindowGL::hierarchyTreeSelectionHighlightsTheNodeInTheView() {
 }
 
 int main(int argc, char* argv[]) {
-    QSurfaceFormat format;
-    format.setVersion(4, 5);
-    format.setProfile(QSurfaceFormat::CoreProfile);
-    format.setDepthBufferSize(24);
-    QSurfaceFormat::setDefaultFormat(format);
+    omicron::useCoreProfileByDefault();
     QApplication app(argc, argv);
     TestMainWindowGL test;
     return QTest::qExec(&test, argc, argv);

@@ -20,7 +20,6 @@
 #include <QSettings>
 #include <QSignalSpy>
 #include <QStandardPaths>
-#include <QSurfaceFormat>
 #include <QtTest>
 
 using namespace omicron;
@@ -159,11 +158,7 @@ private slots:
 };
 
 int main(int argc, char* argv[]) {
-    QSurfaceFormat format;
-    format.setVersion(4, 5);
-    format.setProfile(QSurfaceFormat::CoreProfile);
-    format.setDepthBufferSize(24);
-    QSurfaceFormat::setDefaultFormat(format);
+    omicron::useCoreProfileByDefault();
     QApplication app(argc, argv);
     TestMainWindowClassesGL test;
     return QTest::qExec(&test, argc, argv);
