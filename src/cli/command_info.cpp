@@ -5,13 +5,13 @@
 #include "formats/omh_reader.hpp"
 #include "formats/oms_reader.hpp"
 #include "io/las/las_extra_bytes.hpp"
+#include "io/las/las_header.hpp"
 #include "io/las/las_writer.hpp"
 #include "io/point_reader.hpp"
 #include "json_writer.hpp"
 #include "omh_info.hpp"
 #include "points/attribute_statistics.hpp"
 
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 
@@ -26,8 +26,7 @@ std::string coordinateSystem(const CloudInfo& info) {
     for (const LasVariableLengthRecord& record :
          parseVariableLengthRecords(info.lasProjectionRecords)) {
         if (record.recordId == 2112) {
-            const auto* text = reinterpret_cast<const char*>(record.payload.data());
-            return std::string(text, std::find(text, text + record.payload.size(), '\0'));
+            return las::fixedLengthText(record.payload.data(), record.payload.size());
         }
         if (record.recordId == 34735) {
             found = "GeoTIFF keys";

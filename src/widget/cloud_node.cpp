@@ -83,7 +83,7 @@ void CloudNode::setHierarchy(std::shared_ptr<const Hierarchy> hierarchy) {
     m_boundsMin = glm::dvec3(1.0);
     m_boundsMax = glm::dvec3(0.0);
     m_gpsTimeBase.reset();
-    m_gpsTimes = GpsTimeRange{};
+    m_gpsTimes = ValueRange{};
 }
 
 void CloudNode::setPreview(std::vector<PointVertex> vertices) {
@@ -395,7 +395,7 @@ void CloudNode::setCommonUniforms(QOpenGLShaderProgram& program, const RenderCon
     program.setUniformValue("u_levelColor", QVector3D(1, 1, 1));
     program.setUniformValue("u_buildAge", 0.0f);
     // The GPS range grows with every upload; vertices already on the GPU follow through it.
-    program.setUniformValue("u_gpsTimeRange", QVector2D(m_gpsTimes.min, m_gpsTimes.max));
+    program.setUniformValue("u_gpsTimeRange", QVector2D(static_cast<float>(m_gpsTimes.min), static_cast<float>(m_gpsTimes.max)));
     QOpenGLExtraFunctions& gl = *context.gl;
     const int paletteLocation = program.uniformLocation("u_classColors");
     if (paletteLocation >= 0) {

@@ -106,7 +106,7 @@ private:
     // GPS times are uploaded relative to a base taken from the first node packed, and the
     // range of those packed so far scales the GPS-time colour ramp.
     std::optional<double> m_gpsTimeBase;
-    GpsTimeRange m_gpsTimes;
+    ValueRange m_gpsTimes;
 
     std::size_t m_boundsScanned = 0;
     int m_boundsLevel = -1; // paged: the level whose cells the bounds are

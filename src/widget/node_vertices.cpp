@@ -93,8 +93,8 @@ void packNodeVertices(const Hierarchy& hierarchy, const OctreeNode& node,
     }
 }
 
-GpsTimeRange packNodesVertices(const Hierarchy& hierarchy, std::span<const OctreeNode* const> nodes,
-                               std::vector<std::vector<PointVertex>>& out, double gpsTimeBase) {
+ValueRange packNodesVertices(const Hierarchy& hierarchy, std::span<const OctreeNode* const> nodes,
+                             std::vector<std::vector<PointVertex>>& out, double gpsTimeBase) {
     if (out.size() < nodes.size()) {
         out.resize(nodes.size());
     }
@@ -102,7 +102,7 @@ GpsTimeRange packNodesVertices(const Hierarchy& hierarchy, std::span<const Octre
     tbb::parallel_for(std::size_t{0}, nodes.size(), [&](std::size_t i) {
         packNodeVertices(hierarchy, *nodes[i], out[i], scratch.local(), gpsTimeBase);
     });
-    GpsTimeRange range;
+    ValueRange range;
     for (const NodePackScratch& local : scratch) {
         range.add(local.gpsTimes);
     }

@@ -12,6 +12,7 @@
 #pragma once
 
 #include "build/splat_estimator.hpp"
+#include "points/attribute_statistics.hpp"
 
 #include <cstdint>
 #include <span>
@@ -31,27 +32,9 @@ struct PointVertex {
     std::uint8_t returnNumber = 0;
     std::uint8_t numberOfReturns = 0;
     std::uint8_t lasFlags = 0; // las_flag bits (spare for the shaders today)
-    float gpsTime = 0.0f;      // seconds after NodePackOptions::gpsTimeBase
+    float gpsTime = 0.0f;      // seconds after packNodeVertices's gpsTimeBase
 };
 static_assert(sizeof(PointVertex) == 32, "PointVertex is the GPU layout: keep it 32 bytes");
-
-// The GPS times of packed vertices (relative to the base), to scale the GPS-time ramp.
-struct GpsTimeRange {
-    float min = 0.0f;
-    float max = 0.0f;
-    bool empty = true;
-    void add(float value) {
-        min = empty || value < min ? value : min;
-        max = empty || value > max ? value : max;
-        empty = false;
-    }
-    void add(const GpsTimeRange& other) {
-        if (!other.empty) {
-            add(other.min);
-            add(other.max);
-        }
-    }
-};
 
 // Packs a unit normal into GL_INT_2_10_10_10_REV (x in the low 10 bits), signed normalised.
 std::uint32_t packNormal2101010(float x, float y, float z);
@@ -60,7 +43,7 @@ std::uint32_t packNormal2101010(float x, float y, float z);
 struct NodePackScratch {
     NodeSplats splats;
     SplatScratch estimate;
-    GpsTimeRange gpsTimes;
+    ValueRange gpsTimes;
 };
 
 // The GPS time a cloud's vertices are relative to: that of the first point of `node` (any
@@ -77,8 +60,7 @@ void packNodeVertices(const Hierarchy& hierarchy, const OctreeNode& node,
 // Packs nodes[i] into out[i] (out grows to nodes.size()), the nodes in parallel (oneTBB): the
 // splat estimates make packing the costly part of an upload. Returns the range of the packed
 // GPS times (relative to `gpsTimeBase`; empty without GPS times).
-GpsTimeRange packNodesVertices(const Hierarchy& hierarchy, std::span<const OctreeNode* const> nodes,
-                               std::vector<std::vector<PointVertex>>& out,
-                               double gpsTimeBase = 0.0);
+ValueRange packNodesVertices(const Hierarchy& hierarchy, std::span<const OctreeNode* const> nodes,
+                             std::vector<std::vector<PointVertex>>& out, double gpsTimeBase = 0.0);
 
 } // namespace omicron

@@ -493,6 +493,9 @@ PreviewSample BuildPipeline::preview() const {
     {
         std::lock_guard lock(m_mutex);
         sorter = m_sorter;
+        if (sorter && m_hierarchyPreview) {
+            return *m_hierarchyPreview;
+        }
         if (!sorter && !m_provisional.empty()) {
             // The bounds pre-pass's sample, framed by its own bounds so far: the final cube
             // is not known yet, and the sorter's preview replaces this one once reading starts.
@@ -507,12 +510,6 @@ PreviewSample BuildPipeline::preview() const {
             }
             provisional.pointsSeen = m_provisional.size();
             provisional.provisional = true;
-        }
-    }
-    {
-        std::lock_guard lock(m_mutex);
-        if (sorter && m_hierarchyPreview) {
-            return *m_hierarchyPreview;
         }
     }
     return sorter ? sorter->preview() : provisional;

@@ -28,6 +28,12 @@ struct ValueRange {
             max = value > max ? value : max;
         }
     }
+    void add(const ValueRange& other) {
+        if (!other.empty) {
+            add(other.min);
+            add(other.max);
+        }
+    }
 };
 
 // One named range, as listed: "intensity", "classification", "gps time", ...

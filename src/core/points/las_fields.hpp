@@ -55,6 +55,8 @@ inline constexpr std::uint8_t kEdgeOfFlightLine = 1u << 7;
 // Where the fields sit in one point's LAS column bytes.
 struct LasColumnLayout {
     static constexpr std::size_t kBaseBytes = 8;
+    // The column without extra bytes at its largest: base, GPS time, NIR.
+    static constexpr std::size_t kMaxFieldBytes = kBaseBytes + 8 + 2;
     std::size_t gpsTimeOffset = 0; // valid when the attribute is present
     std::size_t nirOffset = 0;
     std::size_t extraOffset = 0;
@@ -77,7 +79,7 @@ struct LasColumnLayout {
         }
         layout.extraOffset = at;
         layout.extraBytes = attributes.extraBytes();
-        layout.bytes = at + layout.extraBytes; // == attributes.lasBytes()
+        layout.bytes = attributes.lasBytes();
         return layout;
     }
 };

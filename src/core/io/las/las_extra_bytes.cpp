@@ -1,6 +1,7 @@
 #include "io/las/las_extra_bytes.hpp"
 
-#include <algorithm>
+#include "io/las/las_header.hpp"
+
 #include <array>
 
 namespace omicron::las {
@@ -13,11 +14,6 @@ constexpr std::array<const char*, 11> kScalarNames{"",      "uint8", "int8",   "
                                                    "int16", "uint32", "int32", "uint64",
                                                    "int64", "float32", "float64"};
 
-std::string text(const std::uint8_t* bytes, std::size_t capacity) {
-    const auto* begin = reinterpret_cast<const char*>(bytes);
-    return std::string(begin, std::find(begin, begin + capacity, '\0'));
-}
-
 } // namespace
 
 std::vector<ExtraBytesField> parseExtraBytesDescriptors(std::span<const std::uint8_t> descriptors) {
@@ -27,8 +23,8 @@ std::vector<ExtraBytesField> parseExtraBytesDescriptors(std::span<const std::uin
         const std::uint8_t* d = descriptors.data() + at;
         ExtraBytesField field;
         field.dataType = d[2];
-        field.name = text(d + 4, 32);
-        field.description = text(d + 160, 32);
+        field.name = fixedLengthText(d + 4, 32);
+        field.description = fixedLengthText(d + 160, 32);
         if (field.dataType == 0) {
             field.bytes = d[3]; // options: the byte count of undocumented bytes
         } else if (field.dataType <= 30) {

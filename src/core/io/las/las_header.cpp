@@ -3,6 +3,7 @@
 #include "io/input_error.hpp"
 #include "io/raw_bytes.hpp"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -300,6 +301,11 @@ std::uint16_t requiredHeaderSize(std::uint8_t versionMinor) {
         return kHeaderSize14;
     }
     return versionMinor == 3 ? kHeaderSize13 : kHeaderSize12;
+}
+
+std::string fixedLengthText(const std::uint8_t* bytes, std::size_t capacity) {
+    const auto* begin = reinterpret_cast<const char*>(bytes);
+    return std::string(begin, std::find(begin, begin + capacity, '\0'));
 }
 
 std::uint16_t minimumRecordLength(std::uint8_t pointFormat) {

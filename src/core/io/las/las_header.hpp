@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <glm/vec3.hpp>
+#include <string>
 #include <vector>
 
 namespace omicron::las {
@@ -56,6 +57,10 @@ inline constexpr std::size_t kRecordReturnBits = 14;
 
 // The header size a version requires (minor 0..4).
 std::uint16_t requiredHeaderSize(std::uint8_t versionMinor);
+
+// A text field of `capacity` bytes, up to its first NUL (LAS pads text with NULs and may fill
+// the field without one).
+std::string fixedLengthText(const std::uint8_t* bytes, std::size_t capacity);
 
 // The standard record length of a point format (0..10): 20, 28, 26, 34, 57, 63, 30, 36, 38,
 // 59, 67. A file may declare longer records (extra bytes), never shorter ones.

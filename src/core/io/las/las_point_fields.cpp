@@ -65,41 +65,12 @@ AttributeSet attributesOfFormat(std::uint8_t pointFormat, std::uint16_t recordLe
     return attributes;
 }
 
-LasFields readLasFields(const std::uint8_t* record, std::uint8_t pointFormat) {
-    LasFields fields;
-    if (pointFormat <= 5) {
-        const std::uint8_t returns = record[legacy::kReturns];
-        const std::uint8_t classByte = record[legacy::kClass];
-        fields.returns = static_cast<std::uint8_t>((returns & 0x07) | ((returns >> 3) & 0x07) << 4);
-        fields.classification = classByte & 0x1f;
-        fields.flags = static_cast<std::uint8_t>((classByte >> 5) | (returns & 0xc0));
-        fields.scanAngle = static_cast<std::int16_t>(
-            std::lround(loadRaw<std::int8_t>(record + legacy::kScanRank) * kScanStepsPerDegree));
-        fields.userData = record[legacy::kUserData];
-        fields.pointSourceId = loadRaw<std::uint16_t>(record + legacy::kSourceId);
-        if (formatHasGpsTime(pointFormat)) {
-            fields.gpsTime = loadRaw<double>(record + legacy::kGpsTime);
-        }
-        return fields;
-    }
-    fields.returns = record[v14::kReturns];
-    fields.flags = record[v14::kFlags];
-    fields.classification = record[v14::kClass];
-    fields.userData = record[v14::kUserData];
-    fields.scanAngle = loadRaw<std::int16_t>(record + v14::kScanAngle);
-    fields.pointSourceId = loadRaw<std::uint16_t>(record + v14::kSourceId);
-    fields.gpsTime = loadRaw<double>(record + v14::kGpsTime);
-    if (formatHasNir(pointFormat)) {
-        fields.nir = loadRaw<std::uint16_t>(record + v14::kNir);
-    }
-    return fields;
-}
-
 void readLasColumn(const std::uint8_t* record, std::uint8_t pointFormat,
                    const LasColumnLayout& layout, std::uint8_t* column) {
     if (pointFormat <= 5) {
-        // readLasFields's conversion, without its rounding per point: the scan angle steps of
-        // every rank come from a table.
+        // Legacy fields mapped onto LAS 1.4's: 3-bit returns to nibbles, the class byte's flags
+        // to the flags byte, the scan angle rank's whole degrees to 0.006 degree steps (from a
+        // table: no rounding per point).
         static const std::array<std::int16_t, 256> kRankSteps = [] {
             std::array<std::int16_t, 256> steps{};
             for (int byte = 0; byte < 256; ++byte) {
@@ -133,6 +104,15 @@ void readLasColumn(const std::uint8_t* record, std::uint8_t pointFormat,
     }
     std::memcpy(column + layout.extraOffset, record + minimumRecordLength(pointFormat),
                 layout.extraBytes);
+}
+
+LasFields readLasFields(const std::uint8_t* record, std::uint8_t pointFormat) {
+    // The fields alone: a layout without extra bytes, whatever the record holds after them.
+    const AttributeSet attributes = attributesOfFormat(pointFormat, minimumRecordLength(pointFormat));
+    const LasColumnLayout layout = LasColumnLayout::of(attributes);
+    std::array<std::uint8_t, LasColumnLayout::kMaxFieldBytes> column{};
+    readLasColumn(record, pointFormat, layout, column.data());
+    return decodeLasFields(attributes, column.data());
 }
 
 void writeLasFields(const LasFields& fields, std::uint8_t pointFormat, std::uint8_t* record) {

@@ -22,7 +22,7 @@ bool formatHasWaveform(std::uint8_t pointFormat);
 // colour where the format has it.
 AttributeSet attributesOfFormat(std::uint8_t pointFormat, std::uint16_t recordLength);
 
-// The fields of `record` (a record of `pointFormat`).
+// The fields of `record` (a record of `pointFormat`), through readLasColumn.
 LasFields readLasFields(const std::uint8_t* record, std::uint8_t pointFormat);
 // Fills one point's LAS column (`layout` of the cloud's attributes) from `record` (of
 // `pointFormat`, `layout.extraBytes` extra bytes after its standard fields): the reader's hot

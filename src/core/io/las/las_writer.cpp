@@ -253,10 +253,6 @@ void LasStreamWriter::finish() {
 std::vector<LasVariableLengthRecord> parseVariableLengthRecords(
     const std::vector<std::uint8_t>& stored) {
     std::vector<LasVariableLengthRecord> records;
-    const auto text = [](const std::uint8_t* bytes, std::size_t capacity) {
-        const auto* begin = reinterpret_cast<const char*>(bytes);
-        return std::string(begin, std::find(begin, begin + capacity, '\0'));
-    };
     for (std::size_t at = 0; at + las::kVlrHeaderSize <= stored.size();) {
         const std::uint8_t* header = stored.data() + at;
         const auto length = loadRaw<std::uint16_t>(header + 20);
@@ -264,9 +260,9 @@ std::vector<LasVariableLengthRecord> parseVariableLengthRecords(
             break;
         }
         LasVariableLengthRecord record;
-        record.userId = text(header + 2, 16);
+        record.userId = las::fixedLengthText(header + 2, 16);
         record.recordId = loadRaw<std::uint16_t>(header + 18);
-        record.description = text(header + 22, 32);
+        record.description = las::fixedLengthText(header + 22, 32);
         record.payload.assign(header + las::kVlrHeaderSize,
                               header + las::kVlrHeaderSize + length);
         records.push_back(std::move(record));
