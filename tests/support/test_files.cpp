@@ -29,6 +29,10 @@ std::string sharedDataFile(const std::string& name) {
     return std::filesystem::is_regular_file(path) ? path.string() : std::string();
 }
 
+std::string repoDataFile(const std::string& name) {
+    return (std::filesystem::path(OMICRON_REPO_TEST_DATA_DIR) / name).string();
+}
+
 std::string fileParamName(std::string fileName) {
     // Test names allow letters, digits and '_' only ("laz/a-b.laz" -> "laz_a_b_laz").
     for (char& c : fileName) {

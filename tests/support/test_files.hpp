@@ -26,6 +26,9 @@ private:
 // ../shared/data/NAME, or "" when the file is absent (call GTEST_SKIP then).
 std::string sharedDataFile(const std::string& name);
 
+// tests/data/NAME: small files kept in the repository (always present).
+std::string repoDataFile(const std::string& name);
+
 // Expands to GTEST_SKIP() with a message when ../shared/data/NAME is absent; else sets VAR.
 #define OMICRON_REQUIRE_SHARED_FILE(VAR, NAME)                                                     \
     const std::string VAR = ::omicron::test::sharedDataFile(NAME);                                 \

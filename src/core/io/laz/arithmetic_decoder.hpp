@@ -132,6 +132,13 @@ public:
         return (high << 16) | low;
     }
 
+    // Low 32 bits first (GPSTIME11 version 1's full times).
+    std::uint64_t readInt64() {
+        const std::uint64_t low = readInt();
+        const std::uint64_t high = readInt();
+        return (high << 32) | low;
+    }
+
     // True when decoding needed bytes past the end of its span.
     bool overran() const { return m_missingBytes != 0; }
     // Bytes of the span consumed so far (at most its size).

@@ -4,6 +4,7 @@
 #include "io/laz/byte14_decoder.hpp"
 #include "io/laz/byte_decoder.hpp"
 #include "io/laz/gpstime_decoder.hpp"
+#include "io/laz/items_v1.hpp"
 #include "io/laz/point10_decoder.hpp"
 #include "io/laz/rgb14_decoder.hpp"
 #include "io/laz/rgb_decoder.hpp"
@@ -26,6 +27,20 @@ constexpr const char* kPoint14LayerNames[kPoint14Layers] = {"channel, returns an
                                                             "GPS time"};
 
 std::unique_ptr<PointwiseItemDecoder> makePointwise(const Item& item) {
+    if (item.version == 1) { // LASzip 1.x
+        switch (item.type) {
+        case ItemType::Point10:
+            return std::make_unique<Point10V1Decoder>();
+        case ItemType::GpsTime11:
+            return std::make_unique<GpsTime11V1Decoder>();
+        case ItemType::Rgb12:
+            return std::make_unique<Rgb12V1Decoder>();
+        case ItemType::Byte:
+            return std::make_unique<ByteV1Decoder>(item.size);
+        default:
+            break;
+        }
+    }
     switch (item.type) {
     case ItemType::Point10:
         return std::make_unique<Point10Decoder>();

@@ -117,12 +117,13 @@ public:
         vlr.versionRevision = load<std::uint16_t>(m_payload, 6);
         vlr.options = load<std::uint32_t>(m_payload, 8);
         vlr.chunkSize = load<std::uint32_t>(m_payload, kChunkSizeAt);
-        if (vlr.chunkSize == 0) {
+        if (vlr.compressor == Compressor::Pointwise) {
+            // One chunk, however many points: LASzip ignores the field here, and LASzip 1.x
+            // wrote 0 or 1 into it.
+            vlr.chunkSize = kVariableChunkSize;
+        } else if (vlr.chunkSize == 0) {
             fail(InputErrorKind::MalformedHeader, kChunkSizeAt,
                  "LAZ chunk size 0, expected a number of points or 4294967295 (variable)");
-        }
-        if (vlr.compressor == Compressor::Pointwise) {
-            vlr.chunkSize = kVariableChunkSize; // one chunk, however many points
         }
         parseItems(vlr);
         return vlr;
@@ -227,13 +228,13 @@ private:
                      ") are not supported: decompress the file with 'laszip' or drop the "
                      "waveforms ('las2las -set_point_type')");
         }
-        const bool supported =
-            isLayered(item.type) ? (item.version >= 2 && item.version <= 4) : item.version == 2;
+        const bool supported = isLayered(item.type) ? (item.version >= 2 && item.version <= 4)
+                                                    : (item.version == 1 || item.version == 2);
         if (!supported) {
             fail(InputErrorKind::UnsupportedFeature, at + 4,
                  std::string("LAZ item ") + toString(item.type) + " version " +
                      std::to_string(item.version) + " is not supported, expected " +
-                     (isLayered(item.type) ? "3 or 4" : "2"));
+                     (isLayered(item.type) ? "3 or 4" : "1 or 2"));
         }
     }
 

@@ -35,7 +35,7 @@ const char* toString(ItemType type);
 struct Item {
     ItemType type = ItemType::Byte;
     std::uint16_t size = 0;    // bytes of the record it fills
-    std::uint16_t version = 0; // 2 for the point-wise items, 3 or 4 for the layered ones
+    std::uint16_t version = 0; // 1 or 2 for the point-wise items, 3 or 4 for the layered ones
 };
 
 // Chunks hold this many points each, except the last; or, with variable chunks, each chunk's
@@ -57,10 +57,10 @@ struct LaszipVlr {
 
 // Parses the record's payload (at byte `payloadOffset` of `path`, for errors) and checks it
 // against the header's point format (0-10, compression bits cleared) and record length: a
-// known compressor and coder, a chunk size > 0, items whose types, versions and sizes are
-// those of the point format followed by the extra bytes (at most 1024). Throws InputError
-// naming the field's byte: MalformedHeader, or UnsupportedFeature (compressor, coder, item
-// type or version, waveform items, more extra bytes).
+// known compressor and coder, a chunk size > 0 (where chunks exist), items whose types, versions
+// and sizes are those of the point format followed by the extra bytes (at most 1024). Throws
+// InputError naming the field's byte: MalformedHeader, or UnsupportedFeature (compressor, coder,
+// item type or version, waveform items, more extra bytes).
 LaszipVlr parseLaszipVlr(std::span<const std::uint8_t> payload, const std::string& path,
                          std::uint64_t payloadOffset, std::uint8_t pointFormat,
                          std::uint16_t recordLength);

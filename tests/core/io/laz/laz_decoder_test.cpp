@@ -149,5 +149,25 @@ INSTANTIATE_TEST_SUITE_P(
         return name;
     });
 
+// LASzip 1.x's item version 1 (POINT10, GPSTIME11 and RGB12 v1 on one stream, compressor 1,
+// no chunk table, chunk size field 0): PDAL's copy of a LASzip 1.2r0 file, kept in tests/data,
+// whose points are simple.las's.
+TEST(LazItemVersion1, MatchesReferenceByteForByte) {
+    OMICRON_REQUIRE_SHARED_FILE(lasPath, "laz/simple.las");
+    const std::string lazPath = test::repoDataFile("laz/simple-laszip-v1.laz");
+    const Records reference = readLas(lasPath);
+    for (int threads : {1, 2}) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+        const Records decoded = decodeLaz(lazPath);
+        EXPECT_EQ(decoded.header.pointFormat, 3);
+        ASSERT_EQ(decoded.header.pointCount, 1065u);
+        EXPECT_TRUE(sameRecords(decoded, reference)) << threads << " thread(s)";
+    }
+    LazStreaming slices; // the one chunk decoded in slices of 20 records
+    slices.sliceBytes = 20 * reference.header.recordLength;
+    slices.batchBytes = 4096;
+    EXPECT_TRUE(sameRecords(decodeLaz(lazPath, slices), reference));
+}
+
 } // namespace
 } // namespace omicron

@@ -259,12 +259,12 @@ const Corruption kCorruptions[] = {
          return at(f.item(1));
      },
      InputErrorKind::MalformedHeader, "is RGB12, expected GPSTIME11"},
-    {"PointwiseItemVersion1", "simple.laz",
+    {"PointwiseItemVersion3", "simple.laz",
      [](LazFile& f) {
-         put<std::uint16_t>(f.bytes, f.item(0) + 4, 1);
+         put<std::uint16_t>(f.bytes, f.item(0) + 4, 3);
          return at(f.item(0) + 4);
      },
-     InputErrorKind::UnsupportedFeature, "POINT10 version 1 is not supported"},
+     InputErrorKind::UnsupportedFeature, "POINT10 version 3 is not supported, expected 1 or 2"},
     {"LayeredItemVersion5", "terrascan_fmt8.laz",
      [](LazFile& f) {
          put<std::uint16_t>(f.bytes, f.item(1) + 4, 5);

@@ -22,10 +22,9 @@ TEST(LazReader, LayeredFileDescribesItsCompression) {
     EXPECT_EQ(info.format, CloudFormat::Laz);
     EXPECT_STREQ(toString(info.format), "LAZ");
     EXPECT_EQ(info.pointCount, 697721u);
-    EXPECT_EQ(info.attributes,
-              (AttributeSet(Attribute::Intensity) | Attribute::Color | Attribute::Las |
-               Attribute::GpsTime | Attribute::Nir)
-                  .setExtraBytes(3));
+    EXPECT_EQ(info.attributes, (AttributeSet(Attribute::Intensity) | Attribute::Color |
+                                Attribute::Las | Attribute::GpsTime | Attribute::Nir)
+                                   .setExtraBytes(3));
     EXPECT_TRUE(info.boundsFromHeader);
     expectMentions(info.formatDetail, "LAS 1.4, point format 8, 41-byte records (3 extra bytes)");
     expectMentions(info.formatDetail, "layered chunks (POINT14 v3, RGBNIR14 v3, BYTE14 v3)");
@@ -46,6 +45,14 @@ TEST(LazReader, PointwiseAndCopcFilesDescribeTheirCompression) {
     EXPECT_EQ(copcInfo.format, CloudFormat::Laz);
     expectMentions(copcInfo.formatDetail, "layered chunks (POINT14 v3, RGB14 v3), 65 chunks of "
                                           "variable size");
+}
+
+TEST(LazReader, ItemVersion1FileDescribesItsCompression) {
+    const std::string path = test::repoDataFile("laz/simple-laszip-v1.laz");
+    EXPECT_EQ(detectFormat(path), CloudFormat::Laz);
+    const CloudInfo info = openPointCloud(path)->info();
+    EXPECT_EQ(info.pointCount, 1065u);
+    expectMentions(info.formatDetail, "(POINT10 v1, GPSTIME11 v1, RGB12 v1)");
 }
 
 TEST(LazReader, BatchesHoldAtMostBatchPointsAndEveryPointArrives) {
