@@ -191,7 +191,10 @@ public:
                     bar.label, QColor(235, 235, 235));
             }
         }
+        // Georeferenced: the file names its coordinate system (LAS projection records), or
+        // its coordinates look projected (10^4 units or more from the origin).
         const bool georeferenced =
+            !hierarchy->cloud().lasProjectionRecords().empty() ||
             std::max(std::abs(cube.origin.x), std::abs(cube.origin.y)) >= 1e4;
         if (settings.showNorthArrow && georeferenced) {
             // +y seen from the pivot, as a direction on screen.

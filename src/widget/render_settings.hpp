@@ -61,8 +61,9 @@ struct RenderSettings {
     bool showCutBoundary = true;                    // highlight of the roots of the oblique cut
     bool showAxes = true;                           // axis gizmo in the corner
     bool showScaleBar = true; // a round length at the pivot's depth, bottom right
-    // An arrow to +y (grid north) top right, for georeferenced clouds (coordinates of 10^4
-    // units or more: a projected system, where +y is north).
+    // An arrow to +y (grid north) top right, for georeferenced clouds (the file names a
+    // coordinate system, or coordinates of 10^4 units or more: a projected system, where +y
+    // is north).
     bool showNorthArrow = true;
     EdlMode edl = EdlMode::Auto;
     float edlStrength = 1.0f; // how dark an edge one log2 step of depth deep gets

@@ -2,18 +2,19 @@
 // pixel statistics of renderImage() from fixed cameras.
 #include "build/hierarchy_builder.hpp"
 #include "cloud_view.hpp"
-#include "scale_bar.hpp"
 #include "formats/omh_writer.hpp"
+#include "io/las/las_writer.hpp"
 #include "io/point_reader.hpp"
 #include "pipeline/build_pipeline.hpp"
+#include "scale_bar.hpp"
 #include "sort/morton_sorter.hpp"
 #include "widget_test_support.hpp"
 
 #include <QElapsedTimer>
 #include <QFile>
-#include <QTextStream>
 #include <QSignalSpy>
 #include <QTemporaryDir>
+#include <QTextStream>
 #include <QtTest>
 #include <cmath>
 
@@ -224,7 +225,8 @@ private slots:
         for (const auto& [i, j] : {std::pair{7, 11}, std::pair{0, 0}, std::pair{19, 3}}) {
             const auto picked = view.pickCloudPoint(
                 pixelOf(view, *hierarchy, glm::dvec3(500000.0 + i, 4000000.0 + j, 100.0)));
-            QVERIFY2(picked.has_value(), qPrintable(QStringLiteral("grid point %1 %2").arg(i).arg(j)));
+            QVERIFY2(picked.has_value(),
+                     qPrintable(QStringLiteral("grid point %1 %2").arg(i).arg(j)));
             QVERIFY2(std::abs(picked->source.x - (500000.0 + i)) < 1e-3 &&
                          std::abs(picked->source.y - (4000000.0 + j)) < 1e-3 &&
                          std::abs(picked->source.z - 100.0) < 1e-3,
@@ -301,7 +303,9 @@ private slots:
         view.finishMeasurement();
         QCOMPARE(view.measurements().size(), std::size_t{4});
         QVERIFY2(std::abs(view.measurements()[3].value() - 100.0) < kTolerance,
-                 qPrintable(view.measurements()[3].valueText() + QStringLiteral(" from %1 points").arg(view.measurements()[3].points.size())));
+                 qPrintable(
+                     view.measurements()[3].valueText() +
+                     QStringLiteral(" from %1 points").arg(view.measurements()[3].points.size())));
         QVERIFY(view.measurements()[3].valueText().startsWith(QStringLiteral("100.000")));
 
         // Over empty space a click adds nothing; Escape drops an unfinished one.
@@ -338,8 +342,8 @@ private slots:
             RenderSettings settings = plainSettings();
             settings.mode = mode;
             // Columns 0..9 (x up to 500009.5), turned by a quarter turn: its x along +y.
-            settings.clip = ClipBox{{500004.75, 4000009.5, 100.0}, {10.0, 4.75, 1.0},
-                                    std::acos(-1.0) / 2.0};
+            settings.clip =
+                ClipBox{{500004.75, 4000009.5, 100.0}, {10.0, 4.75, 1.0}, std::acos(-1.0) / 2.0};
             view.setRenderSettings(settings);
             view.update();
             QTRY_VERIFY(view.lastFrameStats().pointsDrawn > 0);
@@ -348,8 +352,7 @@ private slots:
             for (int j : {2, 10, 17}) {
                 const auto inside = view.pickCloudPoint(
                     pixelOf(view, *hierarchy, glm::dvec3(500003.0, 4000000.0 + j, 100.0)));
-                QVERIFY2(inside && std::abs(inside->source.x - 500003.0) < 1e-3,
-                         qPrintable(trace));
+                QVERIFY2(inside && std::abs(inside->source.x - 500003.0) < 1e-3, qPrintable(trace));
                 const auto outside = view.pickCloudPoint(
                     pixelOf(view, *hierarchy, glm::dvec3(500016.0, 4000000.0 + j, 100.0)));
                 QVERIFY2(!outside || outside->source.x < 500010.0,
@@ -402,7 +405,8 @@ private slots:
             }
             return std::pair{bottom[0] - top[0], bottom[1] - top[1]};
         };
-        const auto [redPerspective, greenPerspective] = screenHeights(view.renderImage(QSize(400, 400)));
+        const auto [redPerspective, greenPerspective] =
+            screenHeights(view.renderImage(QSize(400, 400)));
         QVERIFY(!view.orthographic());
         view.setOrthographic(true);
         QVERIFY(view.orthographic());
@@ -461,7 +465,8 @@ private slots:
             }
             return changed;
         };
-        const QRect bottomRight(300, 340, 100, 60), topRight(330, 0, 70, 80), middle(100, 100, 200, 200);
+        const QRect bottomRight(300, 340, 100, 60), topRight(330, 0, 70, 80),
+            middle(100, 100, 200, 200);
         RenderSettings settings = plainSettings();
         view.setRenderSettings(settings);
         const QImage none = view.renderImage(QSize(400, 400));
@@ -487,6 +492,50 @@ private slots:
             settings.showNorthArrow = true;
             view.setRenderSettings(settings);
             QCOMPARE(differs(local, view.renderImage(QSize(400, 400)), QRect(0, 0, 400, 400)), 0);
+        }
+
+        // Local coordinates in a file that names its coordinate system (a LASF_Projection
+        // GeoKeyDirectory: projected, UTM 10N) get the arrow too; the same file without the
+        // record does not.
+        for (const bool withCrs : {false, true}) {
+            const QString las =
+                dir.filePath(withCrs ? QStringLiteral("crs.las") : QStringLiteral("local.las"));
+            Bounds bounds;
+            bounds.extend(glm::dvec3(0.0));
+            bounds.extend(glm::dvec3(19.0, 19.0, 0.0));
+            const CubeTransform cube = CubeTransform::fromBounds(bounds);
+            PointBatch batch;
+            for (int j = 0; j < 20; ++j) {
+                for (int i = 0; i < 20; ++i) {
+                    batch.positions.push_back(cube.toUnit(glm::dvec3(i, j, 0.0)));
+                }
+            }
+            LasWriteOptions options;
+            if (withCrs) {
+                LasVariableLengthRecord keys;
+                keys.userId = "LASF_Projection";
+                keys.recordId = 34735;
+                // Version 1.1.0, one key: ProjectedCSTypeGeoKey (3072) = 32610.
+                for (const std::uint16_t value : {1, 1, 0, 1, 3072, 0, 1, 32610}) {
+                    keys.payload.push_back(static_cast<std::uint8_t>(value & 0xFF));
+                    keys.payload.push_back(static_cast<std::uint8_t>(value >> 8));
+                }
+                options.vlrs.push_back(keys);
+            }
+            writeLas(las.toStdString(), batch, cube, options);
+            view.setHierarchy(test::buildHierarchy(las, BuildOptions{}));
+            view.setStandardView(StandardView::Top);
+            settings.showNorthArrow = false;
+            view.setRenderSettings(settings);
+            const QImage plain = view.renderImage(QSize(400, 400));
+            settings.showNorthArrow = true;
+            view.setRenderSettings(settings);
+            const int arrowPixels = differs(plain, view.renderImage(QSize(400, 400)), topRight);
+            if (withCrs) {
+                QVERIFY2(arrowPixels > 30, "a cloud with a coordinate system gets the arrow");
+            } else {
+                QCOMPARE(arrowPixels, 0);
+            }
         }
     }
 
