@@ -19,8 +19,8 @@
 #include <cstdlib>
 #include <memory>
 #include <new>
-#include <string>
 #include <span>
+#include <string>
 #include <sys/mman.h>
 #include <type_traits>
 
@@ -55,6 +55,18 @@ void unmapScratchFile(void* memory, std::size_t bytes);
 void dropResidentPages(void* memory, std::size_t bytes);
 
 inline constexpr std::size_t kSmallPageBytes = 4096;
+
+// Advises huge pages for the whole 2 MiB pages inside [memory, memory + bytes): for a large
+// buffer allocated elsewhere (a reserved std::vector) and not touched yet, so its first touch
+// takes a fault per 2 MiB instead of per 4 KiB. Advice only: a refusal changes nothing.
+inline void adviseHugePages(const void* memory, std::size_t bytes) {
+    const auto begin = reinterpret_cast<std::uintptr_t>(memory);
+    const std::uintptr_t first = (begin + kHugePageBytes - 1) & ~(kHugePageBytes - 1);
+    const std::uintptr_t last = (begin + bytes) & ~(kHugePageBytes - 1);
+    if (last > first) {
+        madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
+    }
+}
 
 template <typename T> class HugePageArray {
     static_assert(std::is_trivially_copyable_v<T>, "elements are left uninitialised");

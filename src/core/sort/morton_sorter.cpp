@@ -1,6 +1,7 @@
 #include "sort/morton_sorter.hpp"
 
 #include "memory_budget.hpp"
+#include "points/huge_page_buffer.hpp"
 #include "sort/budgeted_cloud.hpp"
 #include "sort/radix_sort.hpp"
 #include "sort/run_merger.hpp"
@@ -8,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <malloc.h>
 #include <stdexcept>
 #include <string>
 #include <tbb/parallel_for.h>
@@ -66,8 +68,8 @@ void gatherColumn(std::uint8_t* out, const std::uint8_t* in, const std::uint32_t
 
 std::uint64_t IncrementalMortonSorter::inMemoryBytes(const CloudInfo& info) {
     // Input in arrival order + bin code and index + the sorted cloud's copy + chunk scratch.
-    const std::uint64_t perPoint = 2 * pointBytes(info.attributes) +
-                                   sizeof(morton::Code) + sizeof(std::uint32_t) + 1;
+    const std::uint64_t perPoint =
+        2 * pointBytes(info.attributes) + sizeof(morton::Code) + sizeof(std::uint32_t) + 1;
     return info.pointCount * perPoint;
 }
 
@@ -86,8 +88,8 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
     const bool spills = inMemoryBytes(info) > budget;
     if (spills) {
         // First: it checks the scratch folder and its free space.
-        const std::uint64_t runPoints =
-            std::max(kMinRunPoints, budget / 2 / RunSpiller::bytesPerBufferedPoint(info.attributes));
+        const std::uint64_t runPoints = std::max(
+            kMinRunPoints, budget / 2 / RunSpiller::bytesPerBufferedPoint(info.attributes));
         m_spiller = std::make_unique<RunSpiller>(
             m_options.tempDir, info.attributes,
             static_cast<std::size_t>(std::min<std::uint64_t>(runPoints, capacity)),
@@ -105,6 +107,16 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
     }
     m_bins.resize(kBins);
     m_input.reserve(capacity);
+    // The arrival-order arrays are the sort's largest first touch (~35 bytes a point): on
+    // huge pages it costs a fault per 2 MiB instead of per 4 KiB.
+    const auto advise = [](const auto& array) {
+        adviseHugePages(array.data(), array.capacity() * sizeof(array[0]));
+    };
+    advise(m_input.positions);
+    advise(m_input.normals);
+    advise(m_input.colors);
+    advise(m_input.intensities);
+    advise(m_input.las);
     const std::size_t perBin = capacity / kBins + 16;
     for (Bin& bin : m_bins) {
         bin.codes.reserve(perBin);
@@ -144,7 +156,9 @@ void IncrementalMortonSorter::add(const PointBatch& batch) {
     m_input.append(batch);
 }
 
-PreviewSample IncrementalMortonSorter::preview() const { return m_preview.sample(); }
+PreviewSample IncrementalMortonSorter::preview() const {
+    return m_preview.sample();
+}
 
 bool IncrementalMortonSorter::cancelled() const {
     return m_options.cancel != nullptr && m_options.cancel->load(std::memory_order_relaxed);
@@ -220,40 +234,47 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                            binOffset[bin - boundaries[c]] + m_bins[bin].codes.size();
                    }
                    tbb::parallel_for(boundaries[c], boundaries[c + 1], [&](std::size_t bin) {
-                       const Bin& from = m_bins[bin];
+                       Bin& from = m_bins[bin];
                        const std::size_t at = binOffset[bin - boundaries[c]];
                        const std::size_t n = from.codes.size();
                        std::copy(from.codes.begin(), from.codes.end(), keys.begin() + at);
                        std::copy(from.indices.begin(), from.indices.end(), indices.begin() + at);
+                       // Sorted bins are not read again: their memory goes back now, so the
+                       // sorted cloud filling up reuses it instead of raising the peak.
+                       from = Bin{};
                        radixSortByKey(std::span(keys.data() + at, n),
                                       std::span(indices.data() + at, n),
                                       std::span(keyScratch.data() + at, n),
                                       std::span(indexScratch.data() + at, n));
                    });
+                   // The freed bins are small heap blocks: hand their pages back to the
+                   // kernel (glibc keeps them otherwise), where the sorted cloud's next pages
+                   // come from.
+                   malloc_trim(0);
                    // Gather every attribute into its sorted place.
                    const SortedCloud::StagedRange out = cloud.stage(chunkBegin[c + 1]);
                    const std::size_t lasBytes = m_input.attributes.lasBytes();
-                   tbb::parallel_for(
-                       tbb::blocked_range<std::size_t>(0, size, 8192),
-                       [&](const tbb::blocked_range<std::size_t>& range) {
-                           for (std::size_t i = range.begin(); i < range.end(); ++i) {
-                               const std::uint32_t from = indices[i];
-                               out.positions[i] = m_input.positions[from];
-                               if (!m_input.normals.empty()) {
-                                   out.normals[i] = m_input.normals[from];
-                               }
-                               if (!m_input.colors.empty()) {
-                                   out.colors[i] = m_input.colors[from];
-                               }
-                               if (!m_input.intensities.empty()) {
-                                   out.intensities[i] = m_input.intensities[from];
-                               }
-                           }
-                           if (lasBytes != 0) {
-                               gatherColumn(out.las.data(), m_input.las.data(), indices.data(),
-                                            range.begin(), range.end(), lasBytes);
-                           }
-                       });
+                   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, size, 8192),
+                                     [&](const tbb::blocked_range<std::size_t>& range) {
+                                         for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                                             const std::uint32_t from = indices[i];
+                                             out.positions[i] = m_input.positions[from];
+                                             if (!m_input.normals.empty()) {
+                                                 out.normals[i] = m_input.normals[from];
+                                             }
+                                             if (!m_input.colors.empty()) {
+                                                 out.colors[i] = m_input.colors[from];
+                                             }
+                                             if (!m_input.intensities.empty()) {
+                                                 out.intensities[i] = m_input.intensities[from];
+                                             }
+                                         }
+                                         if (lasBytes != 0) {
+                                             gatherColumn(out.las.data(), m_input.las.data(),
+                                                          indices.data(), range.begin(),
+                                                          range.end(), lasBytes);
+                                         }
+                                     });
                    cloud.publish(chunkBegin[c + 1]);
                    return c;
                }) &

@@ -4,6 +4,8 @@ namespace omicron {
 
 namespace {
 
+__extension__ using Wide = unsigned __int128;
+
 // splitmix64: a fixed, portable hash, so the preview is the same on every machine.
 std::uint64_t mix(std::uint64_t x) {
     x += 0x9e3779b97f4a7c15ull;
@@ -30,7 +32,10 @@ void PreviewSampler::add(const PointBatch& batch, std::uint64_t firstIndex) {
             }
             continue;
         }
-        const auto slot = static_cast<std::size_t>(mix(m_seed ^ index) % (index + 1));
+        // A uniform slot in [0, index] by a multiply and shift rather than a 64-bit modulo
+        // (a division per point cost the reading thread more than the rest of the sample).
+        const auto slot =
+            static_cast<std::size_t>((static_cast<Wide>(mix(m_seed ^ index)) * (index + 1)) >> 64);
         if (slot < m_capacity) {
             m_sample.positions[slot] = batch.positions[i];
             if (hasColor) {
