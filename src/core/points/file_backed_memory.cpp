@@ -12,18 +12,17 @@ namespace omicron {
 namespace {
 
 [[noreturn]] void fail(const std::string& folder, std::size_t bytes, const char* what, int error) {
-    throw std::runtime_error(folder + ": cannot keep " + std::to_string(bytes >> 20) + " MiB (" +
-                             std::to_string(bytes) +
-                             " bytes) of sorted points beyond the memory budget there (" + what +
-                             ": " + std::strerror(error) +
-                             "); free space there or choose another folder with --temp-dir");
+    throw std::runtime_error(
+        folder + ": cannot keep " + std::to_string(bytes >> 20) + " MiB (" + std::to_string(bytes) +
+        " bytes) of sorted points beyond the memory budget there (" + what + ": " +
+        std::strerror(error) + "); free space there or choose another folder with --temp-dir");
 }
 
 } // namespace
 
-void* mapScratchFile(const std::string& folder, std::size_t bytes) {
+void* mapScratchFile(const std::string& folder, std::size_t bytes, int& fd) {
     // An unnamed file: nothing to remove, whatever way the process ends.
-    const int fd = open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+    fd = open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
     if (fd < 0) {
         fail(folder, bytes, "creating the file", errno);
     }
@@ -34,9 +33,9 @@ void* mapScratchFile(const std::string& folder, std::size_t bytes) {
         fail(folder, bytes, "reserving its space", reserved);
     }
     void* memory = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
-    const int mapError = errno;
-    close(fd); // the mapping keeps the file
     if (memory == MAP_FAILED) {
+        const int mapError = errno;
+        close(fd);
         fail(folder, bytes, "mapping it", mapError);
     }
     // No fault-around: a fault maps its own page only. With it, one pass of parents' samples
@@ -48,7 +47,28 @@ void* mapScratchFile(const std::string& folder, std::size_t bytes) {
     return memory;
 }
 
-void unmapScratchFile(void* memory, std::size_t bytes) { munmap(memory, bytes); }
+void unmapScratchFile(void* memory, std::size_t bytes, int fd) {
+    munmap(memory, bytes);
+    close(fd);
+}
+
+void writeScratchFile(int fd, std::uint64_t offset, const void* data, std::size_t bytes) {
+    const auto* from = static_cast<const std::uint8_t*>(data);
+    while (bytes > 0) {
+        const ssize_t written = pwrite(fd, from, bytes, static_cast<off_t>(offset));
+        if (written < 0 && errno == EINTR) {
+            continue;
+        }
+        if (written <= 0) {
+            throw std::runtime_error(std::string("cannot write sorted points to their scratch "
+                                                 "file beyond the memory budget: ") +
+                                     std::strerror(errno));
+        }
+        from += written;
+        offset += static_cast<std::uint64_t>(written);
+        bytes -= static_cast<std::size_t>(written);
+    }
+}
 
 void dropResidentPages(void* memory, std::size_t bytes) {
     // On a shared file mapping this unmaps the pages only: dirty ones are written back by the

@@ -46,10 +46,14 @@ struct FileBacking {
     std::string folder; // where the unnamed scratch file lives (removed when unmapped)
 };
 
-// Maps `bytes` of a new unnamed file in `folder` (space reserved up front); throws
-// std::runtime_error naming the folder and the bytes when it cannot.
-void* mapScratchFile(const std::string& folder, std::size_t bytes);
-void unmapScratchFile(void* memory, std::size_t bytes);
+// Maps `bytes` of a new unnamed file in `folder` (space reserved up front) and sets `fd` to
+// its descriptor, kept open for writeScratchFile; throws std::runtime_error naming the folder
+// and the bytes when it cannot.
+void* mapScratchFile(const std::string& folder, std::size_t bytes, int& fd);
+void unmapScratchFile(void* memory, std::size_t bytes, int fd);
+// Writes `bytes` at `offset` of the scratch file with `fd` through the page cache; the
+// mapping sees them at once. Throws std::runtime_error (an I/O error: the space is reserved).
+void writeScratchFile(int fd, std::uint64_t offset, const void* data, std::size_t bytes);
 // Gives the pages of [memory, memory + bytes) back (file-backed: their data stays in the
 // file and the page cache).
 void dropResidentPages(void* memory, std::size_t bytes);
@@ -79,8 +83,10 @@ public:
             return;
         }
         m_mappedBytes = hugePageArrayBytes(size * sizeof(T));
-        m_data.reset(static_cast<T*>(mapScratchFile(backing.folder, m_mappedBytes)));
+        int fd = -1;
+        m_data.reset(static_cast<T*>(mapScratchFile(backing.folder, m_mappedBytes, fd)));
         m_data.get_deleter().mappedBytes = m_mappedBytes;
+        m_data.get_deleter().fd = fd;
     }
     explicit HugePageArray(std::size_t size, PageSize pages = PageSize::Huge) : m_size(size) {
         if (size == 0) {
@@ -118,6 +124,17 @@ public:
             madvise(reinterpret_cast<void*>(first), last - first, MADV_WILLNEED);
         }
     }
+    // File-backed only: stores `values` at elements [first, first + values.size()) with a
+    // write to the file rather than through the mapping. A store through the mapping faults
+    // each page in first, and a page of the reserved file reads as zeros the kernel has to
+    // write (measured: 16 % of a 200 M-point build beyond its budget); a whole-page write
+    // needs neither.
+    void writeAt(std::size_t first, std::span<const T> values) const {
+        if (!values.empty()) {
+            writeScratchFile(m_data.get_deleter().fd, first * sizeof(T), values.data(),
+                             values.size_bytes());
+        }
+    }
     // File-backed only: the array's pages leave the resident set (any thread; readers and
     // writers may go on: a page they touch next is faulted back in with its data).
     void dropResident() const {
@@ -129,9 +146,10 @@ public:
 private:
     struct Free {
         std::size_t mappedBytes = 0; // > 0: a scratch-file mapping
+        int fd = -1;                 // its file
         void operator()(T* pointer) const {
             if (mappedBytes != 0) {
-                unmapScratchFile(pointer, mappedBytes);
+                unmapScratchFile(pointer, mappedBytes, fd);
             } else {
                 std::free(pointer);
             }

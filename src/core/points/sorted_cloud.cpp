@@ -36,8 +36,7 @@ SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffs
         throw std::invalid_argument("SortedCloud: only an exact node-order cloud is paged");
     }
     if (storage == PointStorage::Packed) {
-        m_packed =
-            std::make_unique<PackedPointStore>(capacity, attributes.has(Attribute::Color));
+        m_packed = std::make_unique<PackedPointStore>(capacity, attributes.has(Attribute::Color));
     }
 }
 
@@ -50,8 +49,7 @@ SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffs
       m_normals(attributes.has(Attribute::Normal) ? capacity : 0, backing),
       m_colors(attributes.has(Attribute::Color) ? capacity : 0, backing),
       m_intensities(attributes.has(Attribute::Intensity) ? capacity : 0, backing),
-      m_las(capacity * attributes.lasBytes(), backing),
-      m_blockCodes(blockCodeCount(capacity)) {
+      m_las(capacity * attributes.lasBytes(), backing), m_blockCodes(blockCodeCount(capacity)) {
     m_governor = std::make_unique<ResidentSetGovernor>(budgetBytes, [this] {
         m_positions.dropResident();
         m_normals.dropResident();
@@ -72,11 +70,10 @@ SortedCloud::StagedRange SortedCloud::stage(std::size_t end) {
                                  : std::span(array.data() + begin, count);
     };
     const std::size_t lasBytes = m_attributes.lasBytes();
-    StagedRange staged{inPlace(m_positions), inPlace(m_normals), inPlace(m_colors),
-                       inPlace(m_intensities),
-                       lasBytes == 0 ? std::span<std::uint8_t>()
-                                     : std::span(m_las.data() + begin * lasBytes,
-                                                 count * lasBytes)};
+    StagedRange staged{
+        inPlace(m_positions), inPlace(m_normals), inPlace(m_colors), inPlace(m_intensities),
+        lasBytes == 0 ? std::span<std::uint8_t>()
+                      : std::span(m_las.data() + begin * lasBytes, count * lasBytes)};
     if (m_packed) {
         m_stagedPositions.resize(count);
         staged.positions = m_stagedPositions;
@@ -85,7 +82,34 @@ SortedCloud::StagedRange SortedCloud::stage(std::size_t end) {
             staged.colors = m_stagedColors;
         }
     }
+    if (fileBacked()) { // written to the scratch files by publish(), not through the mapping
+        const auto buffer = [&](auto& array, auto& vector, auto& span) {
+            if (array.size() != 0) {
+                vector.resize(span.size());
+                span = vector;
+            }
+        };
+        buffer(m_positions, m_stagedPositions, staged.positions);
+        buffer(m_normals, m_stagedNormals, staged.normals);
+        buffer(m_colors, m_stagedColors, staged.colors);
+        buffer(m_intensities, m_stagedIntensities, staged.intensities);
+        buffer(m_las, m_stagedLas, staged.las);
+    }
     return staged;
+}
+
+void SortedCloud::writeStaged(std::size_t begin) {
+    const std::size_t lasBytes = m_attributes.lasBytes();
+    m_positions.writeAt(begin, std::span<const glm::vec3>(m_stagedPositions));
+    m_normals.writeAt(begin, std::span<const glm::vec3>(m_stagedNormals));
+    m_colors.writeAt(begin, std::span<const glm::u8vec3>(m_stagedColors));
+    m_intensities.writeAt(begin, std::span<const std::uint16_t>(m_stagedIntensities));
+    m_las.writeAt(begin * lasBytes, std::span<const std::uint8_t>(m_stagedLas));
+    m_stagedPositions.clear();
+    m_stagedNormals.clear();
+    m_stagedColors.clear();
+    m_stagedIntensities.clear();
+    m_stagedLas.clear();
 }
 
 void SortedCloud::publish(std::size_t newSortedEnd) {
@@ -98,9 +122,21 @@ void SortedCloud::publish(std::size_t newSortedEnd) {
         m_stagedPositions.clear();
         m_stagedColors.clear();
     }
+    if (fileBacked() && newSortedEnd > previous) {
+        // What stage() handed out (all of it: a file-backed cloud publishes whole stages).
+        assert(m_stagedPositions.size() == newSortedEnd - previous);
+        // The block codes from the staged positions, before they go: reading them back
+        // through the mapping would fault every page in.
+        for (std::size_t block = blockCodeCount(previous); block < blockCodeCount(newSortedEnd);
+             ++block) {
+            const glm::vec3 p = m_stagedPositions[block * kBlockCodePoints - previous];
+            m_blockCodes[block] = morton::encodeUnit(p.x, p.y, p.z);
+        }
+        writeStaged(previous);
+    }
     assert(m_order != CloudOrder::Morton || previous == 0 || newSortedEnd == previous ||
            code(previous - 1) <= code(previous));
-    if (m_blockCodes.size() != 0) {
+    if (m_blockCodes.size() != 0 && !fileBacked()) {
         for (std::size_t block = blockCodeCount(previous); block < blockCodeCount(newSortedEnd);
              ++block) {
             m_blockCodes[block] = code(block * kBlockCodePoints);
@@ -115,7 +151,10 @@ void SortedCloud::publish(std::size_t newSortedEnd) {
 void SortedCloud::markComplete() {
     // Staging buffers are only needed while a producer writes.
     m_stagedPositions = {};
+    m_stagedNormals = {};
     m_stagedColors = {};
+    m_stagedIntensities = {};
+    m_stagedLas = {};
     m_complete.store(true, std::memory_order_release);
 }
 

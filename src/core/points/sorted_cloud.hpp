@@ -24,11 +24,11 @@
 #include "points/block_codes.hpp"
 #include "points/cube_transform.hpp"
 #include "points/huge_page_buffer.hpp"
-#include "points/resident_set_governor.hpp"
 #include "points/morton.hpp"
 #include "points/packed_points.hpp"
 #include "points/point_batch.hpp"
 #include "points/position_views.hpp"
+#include "points/resident_set_governor.hpp"
 
 #include <atomic>
 #include <cassert>
@@ -125,7 +125,9 @@ public:
     }
     // What the LAS column's extra bytes are (the source's Extra Bytes descriptors, 192 bytes
     // each), for a LAS export; empty when unknown. Set by the producer before it publishes.
-    const std::vector<std::uint8_t>& lasExtraBytesDescriptors() const { return m_extraBytesDescriptors; }
+    const std::vector<std::uint8_t>& lasExtraBytesDescriptors() const {
+        return m_extraBytesDescriptors;
+    }
     void setLasExtraBytesDescriptors(std::vector<std::uint8_t> descriptors) {
         m_extraBytesDescriptors = std::move(descriptors);
     }
@@ -145,7 +147,8 @@ public:
     // ...or, for either store, the next points [sortedEnd(), end) are written through the spans
     // stage() returns (indexed from 0; an attribute the cloud lacks is empty) and published by
     // publish(end). For a packed cloud positions and colours go to a staging buffer that
-    // publish() encodes.
+    // publish() encodes; a file-backed cloud stages everything and publish() writes it to the
+    // scratch files.
     struct StagedRange {
         std::span<glm::vec3> positions;
         std::span<glm::vec3> normals;
@@ -187,6 +190,8 @@ public:
     void copyRange(std::size_t begin, std::size_t end, PointBatch& out) const;
 
 private:
+    void writeStaged(std::size_t begin); // file-backed: the staged range to the files
+
     CubeTransform m_cube;
     glm::dvec3 m_sourceOffset;
     AttributeSet m_attributes;
@@ -201,10 +206,14 @@ private:
     HugePageArray<std::uint8_t> m_las;
     std::vector<std::uint8_t> m_extraBytesDescriptors;
     std::vector<std::uint8_t> m_projectionRecords;
-    HugePageArray<morton::Code> m_blockCodes;    // CloudOrder::Morton only
+    HugePageArray<morton::Code> m_blockCodes;   // CloudOrder::Morton only
     std::unique_ptr<PackedPointStore> m_packed; // Packed storage only
-    std::vector<glm::vec3> m_stagedPositions;   // Packed: the range stage() handed out
+    // Packed or file-backed: the range stage() handed out, for publish() to encode or write.
+    std::vector<glm::vec3> m_stagedPositions;
+    std::vector<glm::vec3> m_stagedNormals; // file-backed only, as the three below
     std::vector<glm::u8vec3> m_stagedColors;
+    std::vector<std::uint16_t> m_stagedIntensities;
+    std::vector<std::uint8_t> m_stagedLas;
     std::atomic<std::size_t> m_sortedEnd{0};
     std::atomic<bool> m_complete{false};
     // File-backed only; last, so its thread stops before the arrays it drops go.
