@@ -2,6 +2,7 @@
 
 #include "formats/omh_payload_sweep.hpp"
 #include "formats/omh_record_sink.hpp"
+#include "formats/omh_top_levels.hpp"
 #include "io/atomic_file_writer.hpp"
 #include "io/file_stream.hpp"
 
@@ -19,6 +20,7 @@ namespace {
 // subtrees holding at most this many points at a time (and at most an eighth of the budget
 // for a cloud in a scratch file): their splat attributes are held until written.
 constexpr std::uint64_t kSweepBatchPoints = std::uint64_t{4} << 20;
+constexpr std::uint64_t kFileBackedSweepBatchPoints = std::uint64_t{64} << 20;
 
 template <typename T> void store(std::uint8_t* at, const T& value) {
     std::memcpy(at, &value, sizeof(T));
@@ -56,9 +58,8 @@ private:
         const SortedCloud& cloud = m_hierarchy.cloud();
         cloud.keepWithinBudget(); // what the previous batch read may go first
         const std::uint64_t maxCovered =
-            cloud.fileBacked()
-                ? cloud.residentBudget() / 8 / pointBytes(cloud.attributes())
-                : UINT64_MAX;
+            cloud.fileBacked() ? cloud.residentBudget() / 8 / pointBytes(cloud.attributes())
+                               : UINT64_MAX;
         const std::size_t coveredBegin = m_hierarchy.node(level, begin).coveredBegin;
         const auto coveredEnd = [&](std::size_t i) { // of nodes [begin, i]
             const OctreeNode& node = m_hierarchy.node(level, i);
@@ -228,19 +229,56 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
 
     // The top levels (whose nodes cover more than a batch) a level at a time; their points are
     // few. The rest in one sweep over the cloud, each level at its offset in the file.
+    // Over a scratch file, batches as large as an eighth of the budget: the fewer levels are
+    // left above the sweep, the fewer passes over the file (each point's splat attributes, 6
+    // bytes, wait in memory per batch, besides the pages read).
     const std::uint64_t defaultBatch =
         cloud.fileBacked()
             ? std::clamp<std::uint64_t>(cloud.residentBudget() / 8 / pointBytes(cloud.attributes()),
-                                        1, kSweepBatchPoints)
+                                        1, kFileBackedSweepBatchPoints)
             : kSweepBatchPoints;
     const std::uint64_t sweepBatch =
         options.sweepBatchPoints > 0 ? options.sweepBatchPoints : defaultBatch;
     const SubtreePoints subtrees = subtreeHeldPoints(hierarchy);
     const int firstSweptLevel = omhSweepFirstLevel(subtrees, sweepBatch);
-    OmhRecordSink sink(file, cloud, layout);
+    // Over a scratch file, the top levels' points are copied out in one pass first.
+    const std::unique_ptr<TopLevelPoints> top =
+        options.gatherTopLevels && cloud.fileBacked() && firstSweptLevel > 0
+            ? TopLevelPoints::gather(hierarchy, firstSweptLevel, cloud.residentBudget() / 8)
+            : nullptr;
+    OmhRecordSink sink(file, top ? top->cloud() : cloud, layout);
     NodeSplatBatches splats(hierarchy);
+    tbb::enumerable_thread_specific<SplatScratch> scratch;
     for (int level = 0; level < firstSweptLevel; ++level) {
         omh::LevelEntry& entry = header.levels[static_cast<std::size_t>(level)];
+        if (top) {
+            std::vector<OctreeNode> nodes(entry.nodes);
+            std::vector<NodeSplats> levelSplats(entry.nodes);
+            tbb::parallel_for(std::size_t{0}, entry.nodes, [&](std::size_t i) {
+                nodes[i] = top->node(level, i);
+                const OctreeNode& node = hierarchy.node(level, i);
+                if (node.pointCount < kMinPointsPerSplatEstimate) {
+                    // Borrows its shape from its covered range in the source: read in place.
+                    hierarchy.nodeSplats(node, levelSplats[i], scratch.local());
+                } else {
+                    estimateNodeSplats(top->cloud(), nodes[i], SparseSplatRegion{},
+                                       hierarchy.estimatesNormals(), levelSplats[i],
+                                       scratch.local());
+                }
+            });
+            for (std::size_t i = 0; i < entry.nodes; ++i) {
+                const NodeSplats& nodeSplats = levelSplats[i];
+                for (std::uint32_t p = 0; p < nodes[i].pointCount; ++p) {
+                    sink.add(nodes[i].heldPoint(p), nodeSplats.radii[p],
+                             nodeSplats.normals.empty() ? 0u : nodeSplats.normals[p]);
+                }
+            }
+            entry.payloadChecksum = sink.finishSection();
+            if (options.afterLevel) {
+                options.afterLevel(level);
+            }
+            continue;
+        }
         for (std::size_t i = 0; i < entry.nodes; ++i) {
             const OctreeNode& node = hierarchy.node(level, i);
             const NodeSplats& nodeSplats = splats.of(level, i);

@@ -21,6 +21,10 @@ struct OmhWriteOptions {
     // default, 4 Mi, and at most an eighth of the budget for a cloud in a scratch file). The
     // bytes written do not depend on it; tests vary it.
     std::uint64_t sweepBatchPoints = 0;
+    // Over a cloud in a scratch file, copy the top levels' points out in one pass before
+    // writing them (omh_top_levels.hpp) rather than read them in place. The bytes written do
+    // not depend on it; tests turn it off.
+    bool gatherTopLevels = true;
 };
 
 // The header fields a build determines: its parameters and counts.

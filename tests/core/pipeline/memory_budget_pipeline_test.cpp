@@ -2,8 +2,9 @@
 // in-memory build node for node (structure, held points, splats) for the shared scans, the
 // adversarial shapes and the generated scene, with the invariants checked after every pass;
 // the runs are gone after the build and after a cancel.
-#include "hierarchy_test_support.hpp"
+#include "formats/omh_writer.hpp"
 #include "formats/oms_writer.hpp"
+#include "hierarchy_test_support.hpp"
 #include "io/ply/ply_writer.hpp"
 #include "memory_budget.hpp"
 #include "pipeline/build_pipeline.hpp"
@@ -143,6 +144,34 @@ TEST(BudgetedBuild, ASortedStreamBeyondTheBudgetStreamsIntoAFileBackedCloud) {
     EXPECT_TRUE(budgeted.fileBacked);
     EXPECT_EQ(budgeted.print, inMemory.print);
     EXPECT_EQ(entriesIn(scratch.path()), 1u) << "only the .oms: the cloud's file has no name";
+}
+
+// A save over a cloud in a scratch file writes the in-memory build's bytes, whether the top
+// levels' points are copied out in one pass first or read in place, for sweep batches from one
+// point (every level but the deepest above the sweep) to the whole hierarchy.
+TEST(BudgetedBuild, SaveOverTheScratchFileWritesTheInMemoryBytes) {
+    OMICRON_REQUIRE_SHARED_FILE(path, "lion.ply");
+    test::TempDir scratch;
+    BuildPipeline inMemory;
+    const PipelineResult run = inMemory.run(path, options(0, scratch.path().string()));
+    const omh::BuildInfo info = omhBuildInfo(options(0, "").build, run.stats);
+    const std::string reference = scratch.file("reference.omh");
+    writeOmh(reference, *inMemory.hierarchy(), info);
+    BuildPipeline budgeted;
+    budgeted.run(path, options(kMinMemoryBudget, scratch.path().string()));
+    ASSERT_TRUE(budgeted.sortedCloud()->fileBacked());
+    for (const bool gather : {true, false}) {
+        for (const std::uint64_t batch :
+             {std::uint64_t{1}, std::uint64_t{5'000}, std::uint64_t{0}, std::uint64_t{1} << 40}) {
+            SCOPED_TRACE(std::string(gather ? "gathered" : "in place") + ", batch " +
+                         std::to_string(batch));
+            OmhWriteOptions write;
+            write.gatherTopLevels = gather;
+            write.sweepBatchPoints = batch;
+            writeOmh(scratch.file("budgeted.omh"), *budgeted.hierarchy(), info, write);
+            EXPECT_EQ(test::readBytes(scratch.file("budgeted.omh")), test::readBytes(reference));
+        }
+    }
 }
 
 // Cancelled while the runs are merged into the builder: the run returns cancelled, and the

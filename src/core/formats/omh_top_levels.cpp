@@ -1,0 +1,114 @@
+#include "formats/omh_top_levels.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+namespace omicron {
+
+namespace {
+
+// A window whose gathered points are at least one per this many of its points is read ahead
+// whole (a pick every two pages of 12-byte positions, as the sweep's rule); sparser windows
+// fault in only the pages they use.
+constexpr std::uint64_t kDenseStridePoints = 680;
+
+} // namespace
+
+std::unique_ptr<TopLevelPoints> TopLevelPoints::gather(const Hierarchy& hierarchy, int levels,
+                                                       std::uint64_t maxBytes) {
+    const SortedCloud& source = hierarchy.cloud();
+    const AttributeSet attributes = source.attributes();
+    std::uint64_t held = 0;
+    for (int level = 0; level < levels; ++level) {
+        for (std::size_t i = 0; i < hierarchy.nodeCount(level); ++i) {
+            held += hierarchy.node(level, i).pointCount;
+        }
+    }
+    if (held * (pointBytes(attributes) + 2 * sizeof(std::uint32_t)) > maxBytes) {
+        return nullptr;
+    }
+
+    // Which points to gather: every level's held points (a level's are ascending, since its
+    // nodes are in Morton order), merged without repeats.
+    std::vector<std::uint32_t> points;
+    points.reserve(static_cast<std::size_t>(held));
+    for (int level = 0; level < levels; ++level) {
+        for (std::size_t i = 0; i < hierarchy.nodeCount(level); ++i) {
+            const OctreeNode& node = hierarchy.node(level, i);
+            for (std::uint32_t p = 0; p < node.pointCount; ++p) {
+                points.push_back(node.heldPoint(p));
+            }
+        }
+    }
+    std::sort(points.begin(), points.end());
+    points.erase(std::unique(points.begin(), points.end()), points.end());
+
+    std::unique_ptr<TopLevelPoints> top(new TopLevelPoints(hierarchy));
+    top->m_held.resize(static_cast<std::size_t>(levels));
+    top->m_firstHeld.resize(static_cast<std::size_t>(levels));
+    for (int level = 0; level < levels; ++level) {
+        std::vector<std::uint32_t>& renumbered = top->m_held[static_cast<std::size_t>(level)];
+        std::vector<std::uint64_t>& first = top->m_firstHeld[static_cast<std::size_t>(level)];
+        auto at = points.begin();
+        for (std::size_t i = 0; i < hierarchy.nodeCount(level); ++i) {
+            const OctreeNode& node = hierarchy.node(level, i);
+            first.push_back(renumbered.size());
+            for (std::uint32_t p = 0; p < node.pointCount; ++p) {
+                at = std::lower_bound(at, points.end(), node.heldPoint(p));
+                renumbered.push_back(static_cast<std::uint32_t>(at - points.begin()));
+            }
+        }
+    }
+
+    // One pass front to back over the source, a window at a time: read ahead where the
+    // window is dense in gathered points, copied, and released under the budget.
+    top->m_cloud = std::make_shared<SortedCloud>(source.cube(), source.sourceOffset(), attributes,
+                                                 points.size());
+    SortedCloud& cloud = *top->m_cloud;
+    const std::size_t lasBytes = attributes.lasBytes();
+    const std::uint64_t window = std::max<std::uint64_t>(
+        1, (source.fileBacked() ? source.residentBudget() / 8 : std::uint64_t{64} << 20) /
+               pointBytes(attributes));
+    for (std::size_t begin = 0; begin < points.size();) {
+        const std::uint64_t windowEnd = std::uint64_t{points[begin]} + window;
+        const std::size_t end = static_cast<std::size_t>(
+            std::lower_bound(points.begin() + static_cast<std::ptrdiff_t>(begin), points.end(),
+                             windowEnd) -
+            points.begin());
+        if ((end - begin) * kDenseStridePoints >= window) {
+            source.willRead(points[begin], points[end - 1] + 1);
+        }
+        const SortedCloud::StagedRange out = cloud.stage(end);
+        for (std::size_t i = begin; i < end; ++i) {
+            const std::uint32_t from = points[i];
+            const std::size_t to = i - begin;
+            out.positions[to] = source.position(from);
+            if (!out.normals.empty()) {
+                out.normals[to] = source.normals()[from];
+            }
+            if (!out.colors.empty()) {
+                out.colors[to] = source.color(from);
+            }
+            if (!out.intensities.empty()) {
+                out.intensities[to] = source.intensities()[from];
+            }
+            if (lasBytes != 0) {
+                std::memcpy(out.las.data() + to * lasBytes, source.lasRecord(from), lasBytes);
+            }
+        }
+        cloud.publish(end);
+        source.keepWithinBudget();
+        begin = end;
+    }
+    cloud.markComplete();
+    return top;
+}
+
+OctreeNode TopLevelPoints::node(int level, std::size_t index) const {
+    OctreeNode node = m_hierarchy.node(level, index);
+    node.sampleIndices = m_held[static_cast<std::size_t>(level)].data() +
+                         m_firstHeld[static_cast<std::size_t>(level)][index];
+    return node;
+}
+
+} // namespace omicron
