@@ -69,16 +69,31 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
 
     const std::vector<std::uint64_t>& rootPoints = subtrees[static_cast<std::size_t>(firstLevel)];
     const std::size_t roots = rootPoints.size();
-    for (std::size_t begin = 0; begin < roots;) {
-        cloud.keepWithinBudget(); // what the previous batch read may go first
+    // The batch of subtrees that starts at `begin` ends before the returned root.
+    const auto batchEnd = [&](std::size_t begin) {
         std::size_t end = begin + 1;
         for (std::uint64_t points = rootPoints[begin];
              end < roots && points + rootPoints[end] <= maxBatchPoints; ++end) {
             points += rootPoints[end];
         }
-        // A built hierarchy's subtrees cover one stretch of the cloud: read it in bulk.
+        return end;
+    };
+    // A built hierarchy's subtrees cover one stretch of the cloud: read it in bulk.
+    const auto readAhead = [&](std::size_t begin, std::size_t end) {
         cloud.willRead(hierarchy.node(firstLevel, begin).coveredBegin,
                        coveredEnd(hierarchy.node(firstLevel, end - 1)));
+    };
+    if (roots > 0) {
+        readAhead(0, batchEnd(0));
+    }
+    for (std::size_t begin = 0; begin < roots;) {
+        cloud.keepWithinBudget(); // what the previous batch read may go first
+        const std::size_t end = batchEnd(begin);
+        // The next batch's stretch is read while this one is estimated and written (a cloud
+        // in a scratch file: the disk reads ahead instead of waiting for each batch's faults).
+        if (end < roots) {
+            readAhead(end, batchEnd(end));
+        }
         batch.clear();
         std::size_t count = end - begin;
         for (int level = firstLevel; level < levelCount && count > 0; ++level) {
