@@ -3,7 +3,10 @@
 // every constant and every rounding below is part of the LAZ format, not a tuning choice.
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace omicron::laz {
@@ -42,6 +45,18 @@ struct SymbolModel {
     std::uint32_t updateCycle;
     std::uint32_t symbolsUntilUpdate;
 };
+
+// Models chosen by a small previous value, made on first use in a chunk (LASzip makes them
+// lazily too: a fresh model is the encoder's starting state either way).
+template <std::size_t N>
+SymbolModel& lazyModel(std::array<std::unique_ptr<SymbolModel>, N>& models, std::size_t index,
+                       std::uint32_t symbols) {
+    std::unique_ptr<SymbolModel>& model = models[index];
+    if (!model) {
+        model = std::make_unique<SymbolModel>(symbols);
+    }
+    return *model;
+}
 
 // An adaptive model of one binary decision.
 struct BitModel {

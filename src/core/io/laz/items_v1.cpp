@@ -39,11 +39,7 @@ constexpr std::uint32_t kMultiplierLargest = 509;
 } // namespace
 
 SymbolModel& Point10V1Decoder::modelFor(ModelPerByte& models, std::uint8_t previous) {
-    std::unique_ptr<SymbolModel>& model = models[previous];
-    if (!model) {
-        model = std::make_unique<SymbolModel>(256);
-    }
-    return *model;
+    return lazyModel(models, previous, 256);
 }
 
 void Point10V1Decoder::start(const std::uint8_t* item) {

@@ -31,11 +31,7 @@ std::uint32_t evenClass(std::uint32_t k, std::uint32_t limit) {
 Point10Decoder::Point10Decoder() = default;
 
 SymbolModel& Point10Decoder::modelFor(ModelPerByte& models, std::uint8_t previous) {
-    std::unique_ptr<SymbolModel>& model = models[previous];
-    if (!model) {
-        model = std::make_unique<SymbolModel>(256);
-    }
-    return *model;
+    return lazyModel(models, previous, 256);
 }
 
 void Point10Decoder::start(const std::uint8_t* item) {

@@ -41,17 +41,6 @@ std::int32_t wrappingAdd(std::int32_t a, std::int32_t b) {
     return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) + static_cast<std::uint32_t>(b));
 }
 
-// Models chosen by a small previous value, made on first use in the chunk.
-template <std::size_t N>
-SymbolModel& lazyModel(std::array<std::unique_ptr<SymbolModel>, N>& models, std::size_t index,
-                       std::uint32_t symbols) {
-    std::unique_ptr<SymbolModel>& model = models[index];
-    if (!model) {
-        model = std::make_unique<SymbolModel>(symbols);
-    }
-    return *model;
-}
-
 } // namespace
 
 // One scanner channel's models and predictions.
