@@ -17,8 +17,9 @@ namespace omicron {
 namespace {
 
 // The deep levels are written in one sweep over the cloud (omh_payload_sweep), a batch of
-// subtrees holding at most this many points at a time (and at most an eighth of the budget
-// for a cloud in a scratch file): their splat attributes are held until written.
+// subtrees holding at most this many points at a time (for a cloud in a scratch file, up to a
+// 32nd of the budget's worth when that is more, at most the second constant): their splat
+// attributes are held until written.
 constexpr std::uint64_t kSweepBatchPoints = std::uint64_t{4} << 20;
 constexpr std::uint64_t kFileBackedSweepBatchPoints = std::uint64_t{64} << 20;
 
@@ -229,13 +230,16 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
 
     // The top levels (whose nodes cover more than a batch) a level at a time; their points are
     // few. The rest in one sweep over the cloud, each level at its offset in the file.
-    // Over a scratch file, batches as large as an eighth of the budget: the fewer levels are
-    // left above the sweep, the fewer passes over the file (each point's splat attributes, 6
-    // bytes, wait in memory per batch, besides the pages read).
+    // Over a scratch file: at most an eighth of the budget's worth of points, and on a big
+    // budget up to a 32nd of it, so fewer levels are left above the sweep while the batch's
+    // splat attributes (6 bytes a point, held in memory beside the budget's file pages) stay a
+    // small part of the 256 MiB allowed over it.
+    const std::uint64_t budgetPoints =
+        cloud.fileBacked() ? cloud.residentBudget() / pointBytes(cloud.attributes()) : 0;
     const std::uint64_t defaultBatch =
         cloud.fileBacked()
-            ? std::clamp<std::uint64_t>(cloud.residentBudget() / 8 / pointBytes(cloud.attributes()),
-                                        1, kFileBackedSweepBatchPoints)
+            ? std::max(std::clamp<std::uint64_t>(budgetPoints / 8, 1, kSweepBatchPoints),
+                       std::min(budgetPoints / 32, kFileBackedSweepBatchPoints))
             : kSweepBatchPoints;
     const std::uint64_t sweepBatch =
         options.sweepBatchPoints > 0 ? options.sweepBatchPoints : defaultBatch;

@@ -18,7 +18,8 @@ struct OmhWriteOptions {
     // progress, and for the test that kills a save half-way (see omicron-cli build --save).
     std::function<void(int level)> afterLevel;
     // Points held by a batch of the one-pass sweep that writes the deep levels (0: the
-    // default, 4 Mi, and at most an eighth of the budget for a cloud in a scratch file). The
+    // default, 4 Mi; for a cloud in a scratch file at most an eighth of the budget's worth, or a
+    // 32nd of it when that is more). The
     // bytes written do not depend on it; tests vary it.
     std::uint64_t sweepBatchPoints = 0;
     // Over a cloud in a scratch file, copy the top levels' points out in one pass before
