@@ -83,16 +83,17 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
         cloud.willRead(hierarchy.node(firstLevel, begin).coveredBegin,
                        coveredEnd(hierarchy.node(firstLevel, end - 1)));
     };
+    std::size_t end = roots > 0 ? batchEnd(0) : 0;
     if (roots > 0) {
-        readAhead(0, batchEnd(0));
+        readAhead(0, end);
     }
     for (std::size_t begin = 0; begin < roots;) {
         cloud.keepWithinBudget(); // what the previous batch read may go first
-        const std::size_t end = batchEnd(begin);
         // The next batch's stretch is read while this one is estimated and written (a cloud
         // in a scratch file: the disk reads ahead instead of waiting for each batch's faults).
+        const std::size_t nextEnd = end < roots ? batchEnd(end) : roots;
         if (end < roots) {
-            readAhead(end, batchEnd(end));
+            readAhead(end, nextEnd);
         }
         batch.clear();
         std::size_t count = end - begin;
@@ -121,6 +122,7 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
             }
         }
         begin = end;
+        end = nextEnd;
     }
     for (int level = firstLevel; level < levelCount; ++level) {
         levels[static_cast<std::size_t>(level)].payloadChecksum =

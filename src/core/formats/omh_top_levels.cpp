@@ -66,9 +66,8 @@ std::unique_ptr<TopLevelPoints> TopLevelPoints::gather(const Hierarchy& hierarch
                                                  points.size());
     SortedCloud& cloud = *top->m_cloud;
     const std::size_t lasBytes = attributes.lasBytes();
-    const std::uint64_t window = std::max<std::uint64_t>(
-        1, (source.fileBacked() ? source.residentBudget() / 8 : std::uint64_t{64} << 20) /
-               pointBytes(attributes));
+    const std::uint64_t window =
+        std::max<std::uint64_t>(1, source.residentBudget() / 8 / pointBytes(attributes));
     for (std::size_t begin = 0; begin < points.size();) {
         const std::uint64_t windowEnd = std::uint64_t{points[begin]} + window;
         const std::size_t end = static_cast<std::size_t>(

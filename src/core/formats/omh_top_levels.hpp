@@ -21,8 +21,9 @@ namespace omicron {
 
 class TopLevelPoints {
 public:
-    // The held points of levels [0, levels) of `hierarchy` (complete), or nullptr when they
-    // would take more than `maxBytes` in memory (then read them in place).
+    // The held points of levels [0, levels) of `hierarchy` (complete, over a file-backed
+    // cloud, read a window of an eighth of its budget at a time), or nullptr when they would
+    // take more than `maxBytes` in memory (then read them in place).
     static std::unique_ptr<TopLevelPoints> gather(const Hierarchy& hierarchy, int levels,
                                                   std::uint64_t maxBytes);
 

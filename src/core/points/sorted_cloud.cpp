@@ -36,7 +36,8 @@ SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffs
         throw std::invalid_argument("SortedCloud: only an exact node-order cloud is paged");
     }
     if (storage == PointStorage::Packed) {
-        m_packed = std::make_unique<PackedPointStore>(capacity, attributes.has(Attribute::Color));
+        m_packed =
+            std::make_unique<PackedPointStore>(capacity, attributes.has(Attribute::Color));
     }
 }
 
@@ -49,7 +50,8 @@ SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffs
       m_normals(attributes.has(Attribute::Normal) ? capacity : 0, backing),
       m_colors(attributes.has(Attribute::Color) ? capacity : 0, backing),
       m_intensities(attributes.has(Attribute::Intensity) ? capacity : 0, backing),
-      m_las(capacity * attributes.lasBytes(), backing), m_blockCodes(blockCodeCount(capacity)) {
+      m_las(capacity * attributes.lasBytes(), backing),
+      m_blockCodes(blockCodeCount(capacity)) {
     m_governor = std::make_unique<ResidentSetGovernor>(budgetBytes, [this] {
         m_positions.dropResident();
         m_normals.dropResident();
@@ -70,10 +72,11 @@ SortedCloud::StagedRange SortedCloud::stage(std::size_t end) {
                                  : std::span(array.data() + begin, count);
     };
     const std::size_t lasBytes = m_attributes.lasBytes();
-    StagedRange staged{
-        inPlace(m_positions), inPlace(m_normals), inPlace(m_colors), inPlace(m_intensities),
-        lasBytes == 0 ? std::span<std::uint8_t>()
-                      : std::span(m_las.data() + begin * lasBytes, count * lasBytes)};
+    StagedRange staged{inPlace(m_positions), inPlace(m_normals), inPlace(m_colors),
+                       inPlace(m_intensities),
+                       lasBytes == 0 ? std::span<std::uint8_t>()
+                                     : std::span(m_las.data() + begin * lasBytes,
+                                                 count * lasBytes)};
     if (m_packed) {
         m_stagedPositions.resize(count);
         staged.positions = m_stagedPositions;
@@ -122,26 +125,24 @@ void SortedCloud::publish(std::size_t newSortedEnd) {
         m_stagedPositions.clear();
         m_stagedColors.clear();
     }
-    if (fileBacked() && newSortedEnd > previous) {
-        // What stage() handed out (all of it: a file-backed cloud publishes whole stages).
-        assert(m_stagedPositions.size() == newSortedEnd - previous);
-        // The block codes from the staged positions, before they go: reading them back
-        // through the mapping would fault every page in.
+    // A file-backed cloud's new range is still in the staging buffers stage() handed out (all
+    // of it: it publishes whole stages): its block codes come from there, not through the
+    // mapping, which would fault every page in; then it goes to the files.
+    const bool staged = fileBacked() && newSortedEnd > previous;
+    assert(!staged || m_stagedPositions.size() == newSortedEnd - previous);
+    if (m_blockCodes.size() != 0) {
         for (std::size_t block = blockCodeCount(previous); block < blockCodeCount(newSortedEnd);
              ++block) {
-            const glm::vec3 p = m_stagedPositions[block * kBlockCodePoints - previous];
+            const std::size_t i = block * kBlockCodePoints;
+            const glm::vec3 p = staged ? m_stagedPositions[i - previous] : position(i);
             m_blockCodes[block] = morton::encodeUnit(p.x, p.y, p.z);
         }
+    }
+    if (staged) {
         writeStaged(previous);
     }
     assert(m_order != CloudOrder::Morton || previous == 0 || newSortedEnd == previous ||
            code(previous - 1) <= code(previous));
-    if (m_blockCodes.size() != 0 && !fileBacked()) {
-        for (std::size_t block = blockCodeCount(previous); block < blockCodeCount(newSortedEnd);
-             ++block) {
-            m_blockCodes[block] = code(block * kBlockCodePoints);
-        }
-    }
     m_sortedEnd.store(newSortedEnd, std::memory_order_release);
     // A merge or a stream fills a file-backed cloud faster than the governor's thread may
     // be scheduled on a busy machine: look after every published range too.

@@ -26,30 +26,26 @@ constexpr const char* kPoint14LayerNames[kPoint14Layers] = {"channel, returns an
                                                             "point source ID",
                                                             "GPS time"};
 
-std::unique_ptr<PointwiseItemDecoder> makePointwise(const Item& item) {
-    if (item.version == 1) { // LASzip 1.x
-        switch (item.type) {
-        case ItemType::Point10:
-            return std::make_unique<Point10V1Decoder>();
-        case ItemType::GpsTime11:
-            return std::make_unique<GpsTime11V1Decoder>();
-        case ItemType::Rgb12:
-            return std::make_unique<Rgb12V1Decoder>();
-        case ItemType::Byte:
-            return std::make_unique<ByteV1Decoder>(item.size);
-        default:
-            break;
-        }
+// The decoder of an item's version: 1 is LASzip 1.x's coding of the same item (parseLaszipVlr
+// admits 1 and 2).
+template <typename Version1, typename Version2, typename... Arguments>
+std::unique_ptr<PointwiseItemDecoder> byVersion(const Item& item, Arguments... arguments) {
+    if (item.version == 1) {
+        return std::make_unique<Version1>(arguments...);
     }
+    return std::make_unique<Version2>(arguments...);
+}
+
+std::unique_ptr<PointwiseItemDecoder> makePointwise(const Item& item) {
     switch (item.type) {
     case ItemType::Point10:
-        return std::make_unique<Point10Decoder>();
+        return byVersion<Point10V1Decoder, Point10Decoder>(item);
     case ItemType::GpsTime11:
-        return std::make_unique<GpsTime11Decoder>();
+        return byVersion<GpsTime11V1Decoder, GpsTime11Decoder>(item);
     case ItemType::Rgb12:
-        return std::make_unique<Rgb12Decoder>();
+        return byVersion<Rgb12V1Decoder, Rgb12Decoder>(item);
     case ItemType::Byte:
-        return std::make_unique<ByteDecoder>(item.size);
+        return byVersion<ByteV1Decoder, ByteDecoder>(item, std::size_t{item.size});
     default:
         break;
     }
