@@ -8,6 +8,7 @@
 #include "io/laz/point10_decoder.hpp"
 #include "io/laz/rgb14_decoder.hpp"
 #include "io/laz/rgb_decoder.hpp"
+#include "io/laz/wavepacket_decoder.hpp"
 
 #include <cassert>
 #include <cstring>
@@ -46,6 +47,8 @@ std::unique_ptr<PointwiseItemDecoder> makePointwise(const Item& item) {
         return byVersion<Rgb12V1Decoder, Rgb12Decoder>(item);
     case ItemType::Byte:
         return byVersion<ByteV1Decoder, ByteDecoder>(item, std::size_t{item.size});
+    case ItemType::WavePacket13: // coded as version 1 in every version
+        return std::make_unique<WavePacket13Decoder>();
     default:
         break;
     }
@@ -61,6 +64,8 @@ std::unique_ptr<LayeredItemDecoder> makeLayered(const Item& item) {
         return std::make_unique<Rgb14Decoder>(false, version);
     case ItemType::RgbNir14:
         return std::make_unique<Rgb14Decoder>(true, version);
+    case ItemType::WavePacket14:
+        return std::make_unique<WavePacket14Decoder>(version);
     case ItemType::Byte14:
         return std::make_unique<Byte14Decoder>(item.size, version);
     default:
@@ -76,6 +81,8 @@ std::vector<std::string> layerNames(const Item& item) {
         return {"RGB"};
     case ItemType::RgbNir14:
         return {"RGB", "NIR"};
+    case ItemType::WavePacket14:
+        return {"wave packet"};
     default:
         break;
     }

@@ -222,12 +222,6 @@ private:
                      " bytes a point: at most " + std::to_string(kMaxExtraBytes) +
                      " are supported");
         }
-        if (item.type == ItemType::WavePacket13 || item.type == ItemType::WavePacket14) {
-            fail(InputErrorKind::UnsupportedFeature, at,
-                 std::string("LAZ waveform packets (") + toString(item.type) +
-                     ") are not supported: decompress the file with 'laszip' or drop the "
-                     "waveforms ('las2las -set_point_type')");
-        }
         const bool supported = isLayered(item.type) ? (item.version >= 2 && item.version <= 4)
                                                     : (item.version == 1 || item.version == 2);
         if (!supported) {

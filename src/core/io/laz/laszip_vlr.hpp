@@ -60,7 +60,7 @@ struct LaszipVlr {
 // known compressor and coder, a chunk size > 0 (where chunks exist), items whose types, versions
 // and sizes are those of the point format followed by the extra bytes (at most 1024). Throws
 // InputError naming the field's byte: MalformedHeader, or UnsupportedFeature (compressor, coder,
-// item type or version, waveform items, more extra bytes).
+// item type or version, more extra bytes).
 LaszipVlr parseLaszipVlr(std::span<const std::uint8_t> payload, const std::string& path,
                          std::uint64_t payloadOffset, std::uint8_t pointFormat,
                          std::uint16_t recordLength);

@@ -1,12 +1,9 @@
 // The LAZ decoder against an independent one: every record decoded from the real LAZ/COPC
 // files in ../shared/data/laz must equal, byte for byte, the record laz-perf decoded into the
 // reference LAS file (see that folder's README); and with 1 and 2 threads alike.
-#include "io/file_stream.hpp"
-#include "io/las/las_header.hpp"
-#include "io/laz/laz_records.hpp"
+#include "laz_test_records.hpp"
 #include "test_files.hpp"
 
-#include <cstring>
 #include <gtest/gtest.h>
 #include <string>
 #include <tbb/global_control.h>
@@ -15,59 +12,10 @@
 namespace omicron {
 namespace {
 
-struct Records {
-    las::Header header;
-    std::vector<std::uint8_t> bytes; // every record, in file order
-    std::uint64_t blocks = 0;
-};
-
-Records decodeLaz(const std::string& path, const LazStreaming& streaming = {}) {
-    auto stream = std::make_unique<FileStream>(path);
-    Records result;
-    result.header = las::readHeader(*stream);
-    EXPECT_TRUE(result.header.compressed);
-    auto records = openLazRecords(std::move(stream), result.header, streaming);
-    std::uint64_t nextIndex = 0;
-    records->forEachBlock([&](const LasRecordBlock& block) {
-        EXPECT_EQ(block.firstIndex, nextIndex);
-        nextIndex += block.count;
-        result.bytes.insert(result.bytes.end(), block.records,
-                            block.records + block.count * result.header.recordLength);
-        ++result.blocks;
-        return true;
-    });
-    return result;
-}
-
-Records readLas(const std::string& path) {
-    FileStream stream(path);
-    Records result;
-    result.header = las::readHeader(stream);
-    EXPECT_FALSE(result.header.compressed);
-    result.bytes.resize(result.header.pointCount * result.header.recordLength);
-    stream.seek(result.header.pointDataOffset);
-    stream.readExact(result.bytes.data(), result.bytes.size(), "the reference records");
-    return result;
-}
-
-// The first record that differs, as a readable failure.
-::testing::AssertionResult sameRecords(const Records& decoded, const Records& reference) {
-    const std::size_t length = reference.header.recordLength;
-    if (decoded.bytes.size() != reference.bytes.size()) {
-        return ::testing::AssertionFailure()
-               << "decoded " << decoded.bytes.size() / length << " records, the reference has "
-               << reference.bytes.size() / length;
-    }
-    for (std::size_t i = 0; i < decoded.bytes.size(); ++i) {
-        if (decoded.bytes[i] != reference.bytes[i]) {
-            return ::testing::AssertionFailure()
-                   << "record " << i / length << " differs first at its byte " << i % length
-                   << ": decoded " << int(decoded.bytes[i]) << ", reference "
-                   << int(reference.bytes[i]);
-        }
-    }
-    return ::testing::AssertionSuccess();
-}
+using test::decodeLaz;
+using test::Records;
+using test::sameRecords;
+using test::readLasRecords;
 
 struct ReferencePair {
     const char* laz;
@@ -86,7 +34,7 @@ TEST_P(LazDecoder, MatchesReferenceByteForByte) {
     OMICRON_REQUIRE_SHARED_FILE(lazPath, GetParam().laz);
     OMICRON_REQUIRE_SHARED_FILE(lasPath, GetParam().las);
     const Records decoded = decodeLaz(lazPath);
-    const Records reference = readLas(lasPath);
+    const Records reference = readLasRecords(lasPath);
     EXPECT_EQ(decoded.header.pointFormat, GetParam().pointFormat);
     EXPECT_EQ(decoded.header.pointCount, GetParam().points);
     ASSERT_EQ(decoded.header.recordLength, reference.header.recordLength);
@@ -115,7 +63,7 @@ TEST_P(LazDecoder, SameRecordsWithOneAndTwoThreads) {
 TEST_P(LazDecoder, SmallBatchesAndSlicesDecodeTheSameRecords) {
     OMICRON_REQUIRE_SHARED_FILE(lazPath, GetParam().laz);
     OMICRON_REQUIRE_SHARED_FILE(lasPath, GetParam().las);
-    const Records reference = readLas(lasPath);
+    const Records reference = readLasRecords(lasPath);
     const std::uint64_t recordLength = reference.header.recordLength;
 
     LazStreaming slices;
@@ -155,7 +103,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(LazItemVersion1, MatchesReferenceByteForByte) {
     OMICRON_REQUIRE_SHARED_FILE(lasPath, "laz/simple.las");
     const std::string lazPath = test::repoDataFile("laz/simple-laszip-v1.laz");
-    const Records reference = readLas(lasPath);
+    const Records reference = readLasRecords(lasPath);
     for (int threads : {1, 2}) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
         const Records decoded = decodeLaz(lazPath);
