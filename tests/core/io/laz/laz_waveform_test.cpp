@@ -170,9 +170,14 @@ TEST_P(PointwiseWavePackets, DecodeByteForByte) {
         assembly.chunks.push_back(std::move(chunk));
     }
     const std::string lazPath = dir.file("waveform.laz");
-    test::writeBytes(lazPath, laz::test::assembleLaz(assembly));
+    const std::vector<std::uint8_t> laz = laz::test::assembleLaz(assembly);
+    test::writeBytes(lazPath, laz);
 
     expectSameContent(lazPath, lasPath);
+    // The fuzz target's seeds in tests/data are these files.
+    const std::string seed = "laz/waveform-format" + std::to_string(format) + ".laz";
+    EXPECT_TRUE(test::readBytes(test::repoDataFile(seed)) == laz)
+        << seed << " is not the file this test makes";
 }
 
 INSTANTIATE_TEST_SUITE_P(Formats4And5, PointwiseWavePackets, ::testing::Values(4, 5),
