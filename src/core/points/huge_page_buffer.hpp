@@ -72,6 +72,18 @@ inline void adviseHugePages(const void* memory, std::size_t bytes) {
     }
 }
 
+// Gives back the whole small pages inside [memory, memory + bytes) of an anonymous buffer whose
+// contents are no longer needed: they read as zero afterwards, and cost memory again only if
+// touched. For a large buffer consumed piece by piece (the sorter's arrival-order input).
+inline void releasePages(const void* memory, std::size_t bytes) {
+    const auto begin = reinterpret_cast<std::uintptr_t>(memory);
+    const std::uintptr_t first = (begin + kSmallPageBytes - 1) & ~(kSmallPageBytes - 1);
+    const std::uintptr_t last = (begin + bytes) & ~(kSmallPageBytes - 1);
+    if (last > first) {
+        madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
+    }
+}
+
 template <typename T> class HugePageArray {
     static_assert(std::is_trivially_copyable_v<T>, "elements are left uninitialised");
 

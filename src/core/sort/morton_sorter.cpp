@@ -106,6 +106,7 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
         return;
     }
     m_bins.resize(kBins);
+    m_blockLastBin.assign((capacity >> kReleaseBlockBits) + 1, 0);
     m_input.reserve(capacity);
     // The arrival-order arrays are the sort's largest first touch (~35 bytes a point): on
     // huge pages it costs a fault per 2 MiB instead of per 4 KiB.
@@ -149,9 +150,12 @@ void IncrementalMortonSorter::add(const PointBatch& batch) {
     constexpr int binShift = 3 * morton::kMaxLevel - kBinBits;
     for (std::size_t i = 0; i < count; ++i) {
         const morton::Code code = m_batchCodes[i];
-        Bin& bin = m_bins[(code >> binShift) & (kBins - 1)];
+        const auto binIndex = static_cast<std::uint16_t>((code >> binShift) & (kBins - 1));
+        Bin& bin = m_bins[binIndex];
         bin.codes.push_back(code);
         bin.indices.push_back(static_cast<std::uint32_t>(firstIndex + i));
+        std::uint16_t& lastBin = m_blockLastBin[(firstIndex + i) >> kReleaseBlockBits];
+        lastBin = std::max(lastBin, binIndex);
     }
     m_input.append(batch);
 }
@@ -186,6 +190,41 @@ std::vector<std::size_t> IncrementalMortonSorter::chunkBinBoundaries() const {
     return boundaries;
 }
 
+// For each chunk, the input blocks none of whose points a later chunk gathers.
+std::vector<std::vector<std::size_t>> IncrementalMortonSorter::blocksDoneAfterChunk(
+    const std::vector<std::size_t>& boundaries) const {
+    std::vector<std::vector<std::size_t>> done(boundaries.size() - 1);
+    const std::size_t blocks = (m_input.size() + (std::size_t{1} << kReleaseBlockBits) - 1) >>
+                               kReleaseBlockBits;
+    for (std::size_t block = 0; block < blocks; ++block) {
+        // The chunk whose bins hold the block's last bin: the first boundary above it, minus 1.
+        const auto next = std::upper_bound(boundaries.begin(), boundaries.end(),
+                                           std::size_t{m_blockLastBin[block]});
+        done[static_cast<std::size_t>(next - boundaries.begin()) - 1].push_back(block);
+    }
+    return done;
+}
+
+void IncrementalMortonSorter::releaseInputBlock(std::size_t block) {
+    const std::size_t begin = block << kReleaseBlockBits;
+    const std::size_t count =
+        std::min(m_input.size(), begin + (std::size_t{1} << kReleaseBlockBits)) - begin;
+    const auto release = [&](const auto& array) {
+        if (!array.empty()) {
+            constexpr std::size_t bytes = sizeof(array[0]);
+            releasePages(array.data() + begin, count * bytes);
+        }
+    };
+    release(m_input.positions);
+    release(m_input.normals);
+    release(m_input.colors);
+    release(m_input.intensities);
+    const std::size_t lasBytes = m_input.attributes.lasBytes();
+    if (lasBytes != 0) {
+        releasePages(m_input.las.data() + begin * lasBytes, count * lasBytes);
+    }
+}
+
 int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
     if (m_spiller) {
         return mergeAndEmit(consumer);
@@ -193,6 +232,10 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
     const auto start = Clock::now();
     const std::vector<std::size_t> boundaries = chunkBinBoundaries();
     const std::size_t chunks = boundaries.size() - 1;
+    // Input read in a spatially coherent order (scan lines, tiles) is given back as the sort
+    // proceeds instead of at its end: the peak is then less than the input and the sorted
+    // cloud side by side. Input in random order is only given back at the end.
+    const std::vector<std::vector<std::size_t>> blocksDone = blocksDoneAfterChunk(boundaries);
 
     // Chunk c covers sorted positions [chunkBegin[c], chunkBegin[c + 1]).
     std::vector<std::size_t> chunkBegin(chunks + 1, 0);
@@ -273,6 +316,9 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                                             range.begin(), range.end(), lasBytes);
                            }
                        });
+                   for (const std::size_t block : blocksDone[c]) {
+                       releaseInputBlock(block);
+                   }
                    cloud.publish(chunkBegin[c + 1]);
                    return c;
                }) &

@@ -106,7 +106,14 @@ private:
         std::vector<std::uint32_t> indices;
     };
 
+    // The input is given back a block of points at a time, once every chunk that gathers from
+    // the block has been sorted: blockLastBin is the highest bin of the block's points.
+    static constexpr int kReleaseBlockBits = 16;
+
     std::vector<std::size_t> chunkBinBoundaries() const;
+    std::vector<std::vector<std::size_t>> blocksDoneAfterChunk(
+        const std::vector<std::size_t>& boundaries) const;
+    void releaseInputBlock(std::size_t block);
     int mergeAndEmit(const SortedRangeConsumer& consumer);
     bool cancelled() const;
 
@@ -117,6 +124,7 @@ private:
     // Input in arrival order (attributes are gathered from here into the sorted cloud).
     PointBatch m_input;
     std::vector<Bin> m_bins;
+    std::vector<std::uint16_t> m_blockLastBin;
     std::vector<morton::Code> m_batchCodes; // scratch for add()
     std::uint64_t m_pointsAdded = 0;
     std::unique_ptr<RunSpiller> m_spiller; // a spilling sort's runs, else null
