@@ -67,7 +67,8 @@ void gatherColumn(std::uint8_t* out, const std::uint8_t* in, const std::uint32_t
 } // namespace
 
 std::uint64_t IncrementalMortonSorter::inMemoryBytes(const CloudInfo& info) {
-    // Input in arrival order + bin code and index + the sorted cloud's copy + chunk scratch.
+    // Input in arrival order + the sorted cloud's copy + bin index + code (in the sorted cloud
+    // and as a key of the chunk being sorted) + chunk scratch.
     const std::uint64_t perPoint = 2 * pointBytes(info.attributes) +
                                    sizeof(morton::Code) + sizeof(std::uint32_t) + 1;
     return info.pointCount * perPoint;
@@ -118,11 +119,6 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
     advise(m_input.colors);
     advise(m_input.intensities);
     advise(m_input.las);
-    const std::size_t perBin = capacity / kBins + 16;
-    for (Bin& bin : m_bins) {
-        bin.codes.reserve(perBin);
-        bin.indices.reserve(perBin);
-    }
 }
 
 void IncrementalMortonSorter::add(const PointBatch& batch) {
@@ -151,9 +147,7 @@ void IncrementalMortonSorter::add(const PointBatch& batch) {
     for (std::size_t i = 0; i < count; ++i) {
         const morton::Code code = m_batchCodes[i];
         const auto binIndex = static_cast<std::uint16_t>((code >> binShift) & (kBins - 1));
-        Bin& bin = m_bins[binIndex];
-        bin.codes.push_back(code);
-        bin.indices.push_back(static_cast<std::uint32_t>(firstIndex + i));
+        m_bins[binIndex].push(static_cast<std::uint32_t>(firstIndex + i));
         std::uint16_t& lastBin = m_blockLastBin[(firstIndex + i) >> kReleaseBlockBits];
         lastBin = std::max(lastBin, binIndex);
     }
@@ -174,7 +168,7 @@ std::vector<std::size_t> IncrementalMortonSorter::chunkBinBoundaries() const {
     std::uint64_t accumulated = 0;
     int chunk = 1;
     for (std::size_t bin = 0; bin < kBins && chunk < m_options.chunks; ++bin) {
-        accumulated += m_bins[bin].codes.size();
+        accumulated += m_bins[bin].count;
         const std::uint64_t target = total * static_cast<std::uint64_t>(chunk) /
                                      static_cast<std::uint64_t>(m_options.chunks);
         if (accumulated >= target && accumulated > 0 && accumulated < total) {
@@ -243,7 +237,7 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
     for (std::size_t c = 0; c < chunks; ++c) {
         std::size_t size = 0;
         for (std::size_t bin = boundaries[c]; bin < boundaries[c + 1]; ++bin) {
-            size += m_bins[bin].codes.size();
+            size += m_bins[bin].count;
         }
         chunkBegin[c + 1] = chunkBegin[c] + size;
         largestChunk = std::max(largestChunk, size);
@@ -272,17 +266,24 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                    std::vector<std::size_t> binOffset(boundaries[c + 1] - boundaries[c] + 1, 0);
                    for (std::size_t bin = boundaries[c]; bin < boundaries[c + 1]; ++bin) {
                        binOffset[bin - boundaries[c] + 1] =
-                           binOffset[bin - boundaries[c]] + m_bins[bin].codes.size();
+                           binOffset[bin - boundaries[c]] + m_bins[bin].count;
                    }
                    tbb::parallel_for(boundaries[c], boundaries[c + 1], [&](std::size_t bin) {
                        Bin& from = m_bins[bin];
                        const std::size_t at = binOffset[bin - boundaries[c]];
-                       const std::size_t n = from.codes.size();
-                       std::copy(from.codes.begin(), from.codes.end(), keys.begin() + at);
-                       std::copy(from.indices.begin(), from.indices.end(), indices.begin() + at);
+                       const std::size_t n = from.count;
+                       for (std::size_t b = 0; b < from.blocks.size(); ++b) {
+                           const std::size_t first = b * kBinBlock;
+                           std::copy_n(from.blocks[b].get(), std::min(kBinBlock, n - first),
+                                       indices.begin() + at + first);
+                       }
                        // Sorted bins are not read again: their memory goes back now, so the
                        // sorted cloud filling up reuses it instead of raising the peak.
                        from = Bin{};
+                       for (std::size_t i = at; i < at + n; ++i) {
+                           const glm::vec3& p = m_input.positions[indices[i]];
+                           keys[i] = morton::encodeUnit(p.x, p.y, p.z);
+                       }
                        radixSortByKey(std::span(keys.data() + at, n),
                                       std::span(indices.data() + at, n),
                                       std::span(keyScratch.data() + at, n),

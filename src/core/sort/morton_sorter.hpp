@@ -101,9 +101,21 @@ private:
     static constexpr int kBinBits = 12;
     static constexpr std::size_t kBins = std::size_t{1} << kBinBits;
 
+    // A bin's input indices in arrival order, in blocks: a growing bin is never reallocated
+    // and copied, and holds at most one partly filled block. Codes are not kept: the sort
+    // computes them again from the positions, a bin at a time (8 bytes a point less).
+    static constexpr std::size_t kBinBlock = 4096;
     struct Bin {
-        std::vector<std::uint64_t> codes;
-        std::vector<std::uint32_t> indices;
+        std::vector<std::unique_ptr<std::uint32_t[]>> blocks;
+        std::size_t count = 0;
+
+        void push(std::uint32_t index) {
+            if (count % kBinBlock == 0) {
+                blocks.push_back(std::make_unique_for_overwrite<std::uint32_t[]>(kBinBlock));
+            }
+            blocks.back()[count % kBinBlock] = index;
+            ++count;
+        }
     };
 
     // The input is given back a block of points at a time, once every chunk that gathers from
