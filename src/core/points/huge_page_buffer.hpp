@@ -60,28 +60,30 @@ void dropResidentPages(void* memory, std::size_t bytes);
 
 inline constexpr std::size_t kSmallPageBytes = 4096;
 
+// madvise(advice) on the whole pages of `pageBytes` (a power of two) inside
+// [memory, memory + bytes); nothing when there are none.
+inline void adviseWholePages(const void* memory, std::size_t bytes, std::size_t pageBytes,
+                             int advice) {
+    const auto begin = reinterpret_cast<std::uintptr_t>(memory);
+    const std::uintptr_t first = (begin + pageBytes - 1) & ~(pageBytes - 1);
+    const std::uintptr_t last = (begin + bytes) & ~(pageBytes - 1);
+    if (last > first) {
+        madvise(reinterpret_cast<void*>(first), last - first, advice);
+    }
+}
+
 // Advises huge pages for the whole 2 MiB pages inside [memory, memory + bytes): for a large
 // buffer allocated elsewhere (a reserved std::vector) and not touched yet, so its first touch
 // takes a fault per 2 MiB instead of per 4 KiB. Advice only: a refusal changes nothing.
 inline void adviseHugePages(const void* memory, std::size_t bytes) {
-    const auto begin = reinterpret_cast<std::uintptr_t>(memory);
-    const std::uintptr_t first = (begin + kHugePageBytes - 1) & ~(kHugePageBytes - 1);
-    const std::uintptr_t last = (begin + bytes) & ~(kHugePageBytes - 1);
-    if (last > first) {
-        madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
-    }
+    adviseWholePages(memory, bytes, kHugePageBytes, MADV_HUGEPAGE);
 }
 
 // Gives back the whole small pages inside [memory, memory + bytes) of an anonymous buffer whose
 // contents are no longer needed: they read as zero afterwards, and cost memory again only if
 // touched. For a large buffer consumed piece by piece (the sorter's arrival-order input).
 inline void releasePages(const void* memory, std::size_t bytes) {
-    const auto begin = reinterpret_cast<std::uintptr_t>(memory);
-    const std::uintptr_t first = (begin + kSmallPageBytes - 1) & ~(kSmallPageBytes - 1);
-    const std::uintptr_t last = (begin + bytes) & ~(kSmallPageBytes - 1);
-    if (last > first) {
-        madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
-    }
+    adviseWholePages(memory, bytes, kSmallPageBytes, MADV_DONTNEED);
 }
 
 template <typename T> class HugePageArray {
