@@ -147,5 +147,18 @@ TEST(CliInfo, ListsEveryLasAttributeWithItsRangeAndTheClasses) {
     EXPECT_NE(json.out.find("\"return number\":[1,6]"), std::string::npos) << json.out;
 }
 
+// A LAZ file with wave packets (point format 5; tests/data, made by the LAZ test encoder): its
+// points are read, and the user is told the waveforms are not.
+TEST(CliInfo, ReadsLazWithWavePacketsAndSaysWaveformsAreIgnored) {
+    const std::string path = test::repoDataFile("laz/waveform-format5.laz");
+    const auto text = runProcess(OMICRON_CLI_PATH, {"info", path});
+    ASSERT_EQ(text.exitCode, 0) << text.err;
+    for (const char* line : {"LAS 1.4, point format 5, 63-byte records, waveform packets ignored",
+                             "(POINT10 v2, GPSTIME11 v2, RGB12 v2, WAVEPACKET13 v1)",
+                             "points:      250 declared, 250 read"}) {
+        EXPECT_NE(text.out.find(line), std::string::npos) << line << "\n" << text.out;
+    }
+}
+
 } // namespace
 } // namespace omicron
