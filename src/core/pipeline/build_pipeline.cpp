@@ -2,6 +2,7 @@
 
 #include "formats/omh_reader.hpp"
 #include "formats/oms_reader.hpp"
+#include "io/overlapped_batch_consumer.hpp"
 #include "memory_budget.hpp"
 #include "scene/scene_generator.hpp"
 
@@ -317,13 +318,15 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
     readOptions.batchPoints = sortOptions.batchPoints;
     readOptions.cancel = &m_cancel;
     const auto readStart = Clock::now();
-    const ReadSummary read = reader->read(
-        [&](const PointBatch& batch) {
-            sorter->add(batch);
-            m_pointsRead.fetch_add(batch.size(), std::memory_order_relaxed);
-            m_sortRuns.store(sorter->runCount(), std::memory_order_relaxed);
-        },
-        readOptions);
+    // The sorter takes each batch on a thread of its own while the reader parses the next.
+    OverlappedBatchConsumer sorterInput([&](const PointBatch& batch) {
+        sorter->add(batch);
+        m_pointsRead.fetch_add(batch.size(), std::memory_order_relaxed);
+        m_sortRuns.store(sorter->runCount(), std::memory_order_relaxed);
+    });
+    const ReadSummary read =
+        reader->read([&](const PointBatch& batch) { sorterInput.push(batch); }, readOptions);
+    sorterInput.finish();
     result.readSeconds = secondsSince(readStart);
     result.skippedNonFinite = read.skippedNonFinite;
     result.cancelled = read.cancelled;

@@ -1,5 +1,6 @@
 #include "sort/morton_sorter.hpp"
 
+#include "io/overlapped_batch_consumer.hpp"
 #include "memory_budget.hpp"
 #include "points/huge_page_buffer.hpp"
 #include "sort/budgeted_cloud.hpp"
@@ -405,7 +406,11 @@ SortSummary sortPointCloud(PointReader& reader, const SortOptions& options,
     readOptions.batchPoints = options.batchPoints;
     readOptions.cancel = options.cancel;
     const auto readStart = Clock::now();
-    summary.read = reader.read([&](const PointBatch& batch) { sorter.add(batch); }, readOptions);
+    // The sorter takes each batch on a thread of its own while the reader parses the next.
+    OverlappedBatchConsumer sorterInput([&](const PointBatch& batch) { sorter.add(batch); });
+    summary.read =
+        reader.read([&](const PointBatch& batch) { sorterInput.push(batch); }, readOptions);
+    sorterInput.finish();
     summary.readSeconds = secondsSince(readStart);
     summary.points = sorter.pointCount();
     if (summary.read.cancelled) {

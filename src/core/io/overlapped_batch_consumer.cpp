@@ -1,0 +1,79 @@
+#include "io/overlapped_batch_consumer.hpp"
+
+#include <utility>
+
+namespace omicron {
+
+OverlappedBatchConsumer::OverlappedBatchConsumer(Consumer consume)
+    : m_consume(std::move(consume)), m_worker([this](std::stop_token stop) { work(stop); }) {}
+
+OverlappedBatchConsumer::~OverlappedBatchConsumer() { stopWorker(); }
+
+void OverlappedBatchConsumer::push(const PointBatch& batch) {
+    std::unique_lock lock(m_mutex);
+    m_changed.wait(lock, [&] { return !m_hasWaiting || m_failure; });
+    if (m_failure) {
+        std::rethrow_exception(m_failure);
+    }
+    m_waiting = batch; // reuses the buffer's capacity after the first batches
+    m_hasWaiting = true;
+    m_changed.notify_all();
+}
+
+void OverlappedBatchConsumer::finish() {
+    {
+        std::lock_guard lock(m_mutex);
+        m_finished = true;
+    }
+    m_changed.notify_all();
+    if (m_worker.joinable()) {
+        m_worker.join(); // it consumes what is waiting, then returns
+    }
+    rethrowFailure();
+}
+
+void OverlappedBatchConsumer::work(std::stop_token stop) {
+    PointBatch working;
+    while (true) {
+        {
+            std::unique_lock lock(m_mutex);
+            m_changed.wait(lock, stop, [&] { return m_hasWaiting || m_finished; });
+            if (!m_hasWaiting) {
+                return; // finished, or stopped with nothing to do
+            }
+            if (stop.stop_requested()) {
+                return; // the reader gave up: what waits is dropped
+            }
+            std::swap(working, m_waiting);
+            m_hasWaiting = false;
+        }
+        m_changed.notify_all(); // the reader may copy the next batch meanwhile
+        try {
+            m_consume(working);
+        } catch (...) {
+            {
+                std::lock_guard lock(m_mutex);
+                m_failure = std::current_exception();
+            }
+            m_changed.notify_all();
+            return;
+        }
+    }
+}
+
+void OverlappedBatchConsumer::stopWorker() {
+    if (m_worker.joinable()) {
+        m_worker.request_stop();
+        m_changed.notify_all();
+        m_worker.join();
+    }
+}
+
+void OverlappedBatchConsumer::rethrowFailure() {
+    std::lock_guard lock(m_mutex);
+    if (m_failure) {
+        std::rethrow_exception(m_failure);
+    }
+}
+
+} // namespace omicron

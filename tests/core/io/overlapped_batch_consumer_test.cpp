@@ -1,0 +1,101 @@
+// The reader's batches consumed on a thread of their own: every batch once, in order, with its
+// content; a consumer's exception reaches the reader; giving up part way neither hangs nor
+// consumes what was left waiting.
+#include "io/overlapped_batch_consumer.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <gtest/gtest.h>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+namespace omicron {
+namespace {
+
+// Batch k holds k % 7 + 1 points whose x is the running point index.
+PointBatch batchNumber(std::size_t k, std::size_t& nextPoint) {
+    PointBatch batch;
+    batch.attributes = AttributeSet(Attribute::Intensity);
+    for (std::size_t i = 0; i < k % 7 + 1; ++i) {
+        batch.positions.emplace_back(static_cast<float>(nextPoint++), 0.0f, 0.0f);
+        batch.intensities.push_back(static_cast<std::uint16_t>(k));
+    }
+    return batch;
+}
+
+TEST(OverlappedBatchConsumer, ConsumesEveryBatchOnceInOrderWithItsContent) {
+    for (const auto delay : {std::chrono::microseconds(0), std::chrono::microseconds(200)}) {
+        std::vector<float> xs;
+        std::vector<std::uint16_t> batchOfPoint;
+        const std::thread::id reader = std::this_thread::get_id();
+        bool otherThread = true;
+        OverlappedBatchConsumer consumer([&](const PointBatch& batch) {
+            otherThread = otherThread && std::this_thread::get_id() != reader;
+            for (std::size_t i = 0; i < batch.size(); ++i) {
+                xs.push_back(batch.positions[i].x);
+                batchOfPoint.push_back(batch.intensities[i]);
+            }
+            std::this_thread::sleep_for(delay); // a consumer slower than the reader
+        });
+        std::size_t nextPoint = 0;
+        std::vector<std::uint16_t> expectedBatches;
+        for (std::size_t k = 0; k < 200; ++k) {
+            const PointBatch batch = batchNumber(k, nextPoint);
+            expectedBatches.insert(expectedBatches.end(), batch.size(),
+                                   static_cast<std::uint16_t>(k));
+            consumer.push(batch);
+        }
+        consumer.finish();
+        EXPECT_TRUE(otherThread);
+        ASSERT_EQ(xs.size(), nextPoint);
+        for (std::size_t i = 0; i < xs.size(); ++i) {
+            ASSERT_EQ(xs[i], static_cast<float>(i)) << "point " << i;
+        }
+        EXPECT_EQ(batchOfPoint, expectedBatches);
+    }
+}
+
+TEST(OverlappedBatchConsumer, TheConsumersExceptionReachesTheReader) {
+    std::atomic<std::size_t> consumed{0};
+    OverlappedBatchConsumer consumer([&](const PointBatch&) {
+        if (consumed.fetch_add(1) == 5) {
+            throw std::length_error("more points than declared");
+        }
+    });
+    std::size_t nextPoint = 0;
+    bool thrown = false;
+    try {
+        for (std::size_t k = 0; k < 1000; ++k) {
+            consumer.push(batchNumber(k, nextPoint));
+        }
+        consumer.finish();
+    } catch (const std::length_error& error) {
+        thrown = true;
+        EXPECT_STREQ(error.what(), "more points than declared");
+    }
+    EXPECT_TRUE(thrown);
+    EXPECT_EQ(consumed.load(), 6u) << "batches were consumed after the failure";
+}
+
+TEST(OverlappedBatchConsumer, GivingUpPartWayDropsWhatWaitsAndJoins) {
+    std::atomic<std::size_t> consumed{0};
+    std::size_t pushed = 0;
+    {
+        OverlappedBatchConsumer consumer([&](const PointBatch&) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            consumed.fetch_add(1);
+        });
+        std::size_t nextPoint = 0;
+        for (std::size_t k = 0; k < 3; ++k) {
+            consumer.push(batchNumber(k, nextPoint));
+            ++pushed;
+        }
+        // The reader threw here: no finish(), the destructor must not hang.
+    }
+    EXPECT_GE(consumed.load(), 1u);
+    EXPECT_LE(consumed.load(), pushed);
+}
+
+} // namespace
+} // namespace omicron
