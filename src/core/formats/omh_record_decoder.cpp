@@ -39,8 +39,10 @@ std::size_t OmhRecordDecoder::store(const std::uint8_t* records, std::size_t cou
             m_cloud.mutableIntensities()[at] =
                 loadRaw<std::uint16_t>(record + m_layout.point.intensityOffset);
         }
-        std::memcpy(m_cloud.mutableLasColumn().data() + at * m_layout.point.lasBytes,
-                    record + m_layout.point.lasOffset, m_layout.point.lasBytes);
+        if (m_layout.point.lasBytes != 0) { // no LAS column: nowhere to copy to
+            std::memcpy(m_cloud.mutableLasColumn().data() + at * m_layout.point.lasBytes,
+                        record + m_layout.point.lasOffset, m_layout.point.lasBytes);
+        }
         m_splats.setEncoded(at, loadRaw<std::uint16_t>(record + m_layout.radiusOffset),
                             m_estimatedNormals
                                 ? loadRaw<std::uint32_t>(record + m_layout.estimatedNormalOffset)

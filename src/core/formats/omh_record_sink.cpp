@@ -47,8 +47,10 @@ void OmhRecordSink::add(std::uint32_t index, std::uint16_t encodedRadius,
     if (attributes.has(Attribute::Intensity)) {
         storeRaw(record + m_layout.point.intensityOffset, m_cloud.intensities()[index]);
     }
-    std::memcpy(record + m_layout.point.lasOffset, m_cloud.lasRecord(index),
-                m_layout.point.lasBytes);
+    if (m_layout.point.lasBytes != 0) { // no LAS column: no record to copy from
+        std::memcpy(record + m_layout.point.lasOffset, m_cloud.lasRecord(index),
+                    m_layout.point.lasBytes);
+    }
     storeRaw(record + m_layout.radiusOffset, encodedRadius);
     if (m_layout.estimatedNormalOffset != 0) {
         storeRaw(record + m_layout.estimatedNormalOffset, estimatedNormal);

@@ -324,8 +324,10 @@ ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptio
             if (attributes.has(Attribute::Intensity)) {
                 out.intensities[at] = loadRaw<std::uint16_t>(record + m_layout.intensityOffset);
             }
-            std::memcpy(out.las.data() + at * m_layout.lasBytes, record + m_layout.lasOffset,
-                        m_layout.lasBytes);
+            if (m_layout.lasBytes != 0) { // no LAS column: nowhere to copy to
+                std::memcpy(out.las.data() + at * m_layout.lasBytes, record + m_layout.lasOffset,
+                            m_layout.lasBytes);
+            }
         }
         cloud.publish(end);
         consumer(cloud, begin, end);

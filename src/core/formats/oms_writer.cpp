@@ -128,7 +128,9 @@ void OmsWriter::append(const SortedCloud& cloud, std::size_t begin, std::size_t 
             if (m_attributes.has(Attribute::Intensity)) {
                 storeRaw(record + m_layout.intensityOffset, intensities[i]);
             }
-            std::memcpy(record + m_layout.lasOffset, cloud.lasRecord(i), m_layout.lasBytes);
+            if (m_layout.lasBytes != 0) { // no LAS column: no record to copy from
+                std::memcpy(record + m_layout.lasOffset, cloud.lasRecord(i), m_layout.lasBytes);
+            }
         }
         m_checksum->update(m_block.data(), m_block.size());
         m_file->write(m_block.data(), m_block.size());
