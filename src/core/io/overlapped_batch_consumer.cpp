@@ -7,7 +7,9 @@ namespace omicron {
 OverlappedBatchConsumer::OverlappedBatchConsumer(Consumer consume)
     : m_consume(std::move(consume)), m_worker([this](std::stop_token stop) { work(stop); }) {}
 
-OverlappedBatchConsumer::~OverlappedBatchConsumer() { stopWorker(); }
+OverlappedBatchConsumer::~OverlappedBatchConsumer() {
+    stopWorker();
+}
 
 void OverlappedBatchConsumer::push(const PointBatch& batch) {
     std::unique_lock lock(m_mutex);

@@ -44,9 +44,9 @@ private:
     Consumer m_consume;
     std::mutex m_mutex;
     std::condition_variable_any m_changed;
-    PointBatch m_waiting;     // the next batch, copied by push (guarded by m_mutex)
-    bool m_hasWaiting = false; // guarded by m_mutex
-    bool m_finished = false;   // no more pushes (guarded by m_mutex)
+    PointBatch m_waiting;         // the next batch, copied by push (guarded by m_mutex)
+    bool m_hasWaiting = false;    // guarded by m_mutex
+    bool m_finished = false;      // no more pushes (guarded by m_mutex)
     std::exception_ptr m_failure; // guarded by m_mutex
     std::jthread m_worker;        // last: started once the members above exist
 };

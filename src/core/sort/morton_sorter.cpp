@@ -186,11 +186,11 @@ std::vector<std::size_t> IncrementalMortonSorter::chunkBinBoundaries() const {
 }
 
 // For each chunk, the input blocks none of whose points a later chunk gathers.
-std::vector<std::vector<std::size_t>> IncrementalMortonSorter::blocksDoneAfterChunk(
-    const std::vector<std::size_t>& boundaries) const {
+std::vector<std::vector<std::size_t>>
+IncrementalMortonSorter::blocksDoneAfterChunk(const std::vector<std::size_t>& boundaries) const {
     std::vector<std::vector<std::size_t>> done(boundaries.size() - 1);
-    const std::size_t blocks = (m_input.size() + (std::size_t{1} << kReleaseBlockBits) - 1) >>
-                               kReleaseBlockBits;
+    const std::size_t blocks =
+        (m_input.size() + (std::size_t{1} << kReleaseBlockBits) - 1) >> kReleaseBlockBits;
     for (std::size_t block = 0; block < blocks; ++block) {
         // The chunk whose bins hold the block's last bin: the first boundary above it, minus 1.
         const auto next = std::upper_bound(boundaries.begin(), boundaries.end(),

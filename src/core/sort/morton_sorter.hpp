@@ -123,8 +123,8 @@ private:
     static constexpr int kReleaseBlockBits = 16;
 
     std::vector<std::size_t> chunkBinBoundaries() const;
-    std::vector<std::vector<std::size_t>> blocksDoneAfterChunk(
-        const std::vector<std::size_t>& boundaries) const;
+    std::vector<std::vector<std::size_t>>
+    blocksDoneAfterChunk(const std::vector<std::size_t>& boundaries) const;
     void releaseInputBlock(std::size_t block);
     int mergeAndEmit(const SortedRangeConsumer& consumer);
     bool cancelled() const;

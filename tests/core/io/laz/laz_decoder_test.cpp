@@ -13,9 +13,9 @@ namespace omicron {
 namespace {
 
 using test::decodeLaz;
+using test::readLasRecords;
 using test::Records;
 using test::sameRecords;
-using test::readLasRecords;
 
 struct ReferencePair {
     const char* laz;
