@@ -6,6 +6,7 @@
 // with 1 and 2 threads; the reader delivers the same points as the uncompressed file and says
 // that waveforms are ignored.
 #include "io/file_stream.hpp"
+#include "io/input_error.hpp"
 #include "io/las/las_header.hpp"
 #include "io/las/las_point_fields.hpp"
 #include "io/las/las_writer.hpp"
@@ -174,6 +175,18 @@ TEST_P(PointwiseWavePackets, DecodeByteForByte) {
     test::writeBytes(lazPath, laz);
 
     expectSameContent(lazPath, lasPath);
+    // A chunk cut short is an error naming the chunk, never garbage records.
+    assembly.chunks.back().resize(assembly.chunks.back().size() - 8);
+    const std::string truncatedPath = dir.file("truncated.laz");
+    test::writeBytes(truncatedPath, laz::test::assembleLaz(assembly));
+    try {
+        loadPointCloud(truncatedPath);
+        ADD_FAILURE() << "a truncated wave packet chunk was read";
+    } catch (const InputError& error) {
+        EXPECT_EQ(error.kind(), InputErrorKind::CorruptData) << error.what();
+        EXPECT_NE(std::string(error.what()).find("LAZ chunk 2 of 3 (points 200 to 249"), std::string::npos)
+            << error.what();
+    }
     // The fuzz target's seeds in tests/data are these files.
     const std::string seed = "laz/waveform-format" + std::to_string(format) + ".laz";
     EXPECT_TRUE(test::readBytes(test::repoDataFile(seed)) == laz)
