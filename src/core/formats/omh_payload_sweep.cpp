@@ -114,12 +114,7 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
         });
         for (std::size_t b = 0; b < batch.size(); ++b) {
             const OctreeNode& node = hierarchy.node(batch[b].first, batch[b].second);
-            OmhRecordSink& sink = sinks[static_cast<std::size_t>(batch[b].first - firstLevel)];
-            const NodeSplats& nodeSplats = splats[b];
-            for (std::uint32_t p = 0; p < node.pointCount; ++p) {
-                sink.add(node.heldPoint(p), nodeSplats.radii[p],
-                         nodeSplats.normals.empty() ? 0u : nodeSplats.normals[p]);
-            }
+            sinks[static_cast<std::size_t>(batch[b].first - firstLevel)].addNode(node, splats[b]);
         }
         begin = end;
         end = nextEnd;

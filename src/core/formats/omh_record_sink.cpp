@@ -58,6 +58,12 @@ void OmhRecordSink::add(std::uint32_t index, std::uint16_t encodedRadius,
     m_used += m_layout.bytes;
 }
 
+void OmhRecordSink::addNode(const OctreeNode& node, const NodeSplats& splats) {
+    for (std::uint32_t p = 0; p < node.pointCount; ++p) {
+        add(node.heldPoint(p), splats.radii[p], splats.normals.empty() ? 0u : splats.normals[p]);
+    }
+}
+
 std::uint64_t OmhRecordSink::finishSection() {
     flush();
     if (m_positional && m_at > m_regionStart + m_released) {

@@ -4,6 +4,8 @@
 // level's own offset when several levels are filled side by side (omh_payload_sweep).
 #pragma once
 
+#include "build/octree_node.hpp"
+#include "build/splat_estimator.hpp"
 #include "formats/oms_format.hpp"
 #include "formats/omh_format.hpp"
 #include "io/atomic_file_writer.hpp"
@@ -28,6 +30,8 @@ public:
     // One held point (a SortedCloud index) and its splat attributes; `estimatedNormal` is
     // stored only when the layout has room for it.
     void add(std::uint32_t index, std::uint16_t encodedRadius, std::uint32_t estimatedNormal);
+    // Every point `node` holds, with the node's splat attributes, in order.
+    void addNode(const OctreeNode& node, const NodeSplats& splats);
 
     // Writes what is pending and returns the checksum of everything since the last call.
     std::uint64_t finishSection();

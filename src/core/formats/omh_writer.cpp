@@ -272,24 +272,11 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
                 }
             });
             for (std::size_t i = 0; i < entry.nodes; ++i) {
-                const NodeSplats& nodeSplats = levelSplats[i];
-                for (std::uint32_t p = 0; p < nodes[i].pointCount; ++p) {
-                    sink.add(nodes[i].heldPoint(p), nodeSplats.radii[p],
-                             nodeSplats.normals.empty() ? 0u : nodeSplats.normals[p]);
-                }
+                sink.addNode(nodes[i], levelSplats[i]);
             }
-            entry.payloadChecksum = sink.finishSection();
-            if (options.afterLevel) {
-                options.afterLevel(level);
-            }
-            continue;
-        }
-        for (std::size_t i = 0; i < entry.nodes; ++i) {
-            const OctreeNode& node = hierarchy.node(level, i);
-            const NodeSplats& nodeSplats = splats.of(level, i);
-            for (std::uint32_t p = 0; p < node.pointCount; ++p) {
-                sink.add(node.heldPoint(p), nodeSplats.radii[p],
-                         nodeSplats.normals.empty() ? 0u : nodeSplats.normals[p]);
+        } else {
+            for (std::size_t i = 0; i < entry.nodes; ++i) {
+                sink.addNode(hierarchy.node(level, i), splats.of(level, i));
             }
         }
         entry.payloadChecksum = sink.finishSection();

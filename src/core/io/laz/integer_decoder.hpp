@@ -12,6 +12,11 @@
 
 namespace omicron::laz {
 
+// a + b modulo 2^32, as the encoder's 32-bit registers add a coordinate and its difference.
+inline std::int32_t wrappingAdd(std::int32_t a, std::int32_t b) {
+    return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) + static_cast<std::uint32_t>(b));
+}
+
 class IntegerDecoder {
 public:
     // bits: width of the values (1..32); contexts: how many magnitude-class models the caller

@@ -26,10 +26,6 @@ std::int32_t median3(const std::array<std::int32_t, 3>& v) {
     return std::max(std::min(v[0], v[1]), std::min(std::max(v[0], v[1]), v[2]));
 }
 
-std::int32_t wrappingAdd(std::int32_t a, std::int32_t b) {
-    return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) + static_cast<std::uint32_t>(b));
-}
-
 // The multiplier alphabet of GPSTIME11 v1: 0 to 509 multiply the last difference (0 means a
 // quarter of it), 510 is a full new time, 511 the same time again.
 constexpr std::uint32_t kMultiplierFull = 510;

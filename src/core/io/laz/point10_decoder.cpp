@@ -85,14 +85,12 @@ void Point10Decoder::decode(ArithmeticDecoder& decoder, std::uint8_t* item) {
 
     const std::uint32_t single = numberOfReturns == 1 ? 1 : 0;
     const std::int32_t dx = m_dx.decode(decoder, m_xDiffMedian[map].median(), single);
-    m_last.x = static_cast<std::int32_t>(static_cast<std::uint32_t>(m_last.x) +
-                                         static_cast<std::uint32_t>(dx));
+    m_last.x = wrappingAdd(m_last.x, dx);
     m_xDiffMedian[map].add(dx);
 
     const std::int32_t dy =
         m_dy.decode(decoder, m_yDiffMedian[map].median(), single + evenClass(m_dx.k(), 20));
-    m_last.y = static_cast<std::int32_t>(static_cast<std::uint32_t>(m_last.y) +
-                                         static_cast<std::uint32_t>(dy));
+    m_last.y = wrappingAdd(m_last.y, dy);
     m_yDiffMedian[map].add(dy);
 
     const std::uint32_t zClass = (m_dx.k() + m_dy.k()) / 2;

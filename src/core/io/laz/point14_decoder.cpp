@@ -37,10 +37,6 @@ std::uint32_t evenClass(std::uint32_t k, std::uint32_t limit) {
     return k < limit ? (k & ~1u) : limit;
 }
 
-std::int32_t wrappingAdd(std::int32_t a, std::int32_t b) {
-    return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) + static_cast<std::uint32_t>(b));
-}
-
 } // namespace
 
 // One scanner channel's models and predictions.

@@ -227,9 +227,11 @@ UnchangedPointwiseEncoder::UnchangedPointwiseEncoder(std::uint8_t recordFormat,
                                                      const std::uint8_t* first)
     : m_rgb(recordFormat == 5) {
     m_single = ((first[14] >> 3) & 7u) == 1 ? 1 : 0;
-    const std::uint8_t* rgb = first + 28;
-    m_grey = loadRaw<std::uint16_t>(rgb) == loadRaw<std::uint16_t>(rgb + 2) &&
-             loadRaw<std::uint16_t>(rgb) == loadRaw<std::uint16_t>(rgb + 4);
+    if (m_rgb) { // RGB12 follows POINT10 and GPSTIME11
+        const std::uint8_t* rgb = first + 28;
+        m_grey = loadRaw<std::uint16_t>(rgb) == loadRaw<std::uint16_t>(rgb + 2) &&
+                 loadRaw<std::uint16_t>(rgb) == loadRaw<std::uint16_t>(rgb + 4);
+    }
 }
 
 void UnchangedPointwiseEncoder::encode(ArithmeticEncoder& encoder, std::int32_t z) {

@@ -84,7 +84,7 @@ public:
 
 private:
     bool m_rgb;
-    bool m_grey;
+    bool m_grey = false;
     std::uint32_t m_single;    // 1 for a single return: the coordinates' context
     std::int32_t m_lastZ = 0;  // the last z of the point's return level, 0 at first
     SymbolModel m_changed{64}; // POINT10's change mask
