@@ -3,6 +3,8 @@
 #include "formats/omh_record_sink.hpp"
 
 #include <algorithm>
+#include <array>
+#include <future>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <utility>
@@ -63,8 +65,23 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
     // order, so a batch's nodes at each level follow those of the level above: as many as
     // the batch's nodes there have children.
     std::vector<std::size_t> next(static_cast<std::size_t>(levelCount), 0);
-    std::vector<std::pair<int, std::size_t>> batch; // (level, index), level by level
-    std::vector<NodeSplats> splats;
+    // Two batches in flight: while a writer thread encodes, hashes and writes one (serial,
+    // and on a disk mostly waiting for it), the calling thread and TBB estimate the splat
+    // attributes of the next (parallel, and over a scratch file mostly waiting for its reads).
+    // Only the writer touches the sinks; both stages only read the hierarchy and the cloud.
+    struct Batch {
+        std::vector<std::pair<int, std::size_t>> nodes; // (level, index), level by level
+        std::vector<NodeSplats> splats;
+    };
+    std::array<Batch, 2> batches;
+    const auto write = [&](const Batch& batch) {
+        for (std::size_t b = 0; b < batch.nodes.size(); ++b) {
+            const auto [level, index] = batch.nodes[b];
+            sinks[static_cast<std::size_t>(level - firstLevel)].addNode(
+                hierarchy.node(level, index), batch.splats[b]);
+        }
+    };
+    std::future<void> writing; // of the previous batch; its destructor waits for it
     tbb::enumerable_thread_specific<SplatScratch> scratch;
 
     const std::vector<std::uint64_t>& rootPoints = subtrees[static_cast<std::size_t>(firstLevel)];
@@ -87,7 +104,7 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
     if (roots > 0) {
         readAhead(0, end);
     }
-    for (std::size_t begin = 0; begin < roots;) {
+    for (std::size_t begin = 0, slot = 0; begin < roots; slot ^= 1) {
         cloud.keepWithinBudget(); // what the previous batch read may go first
         // The next batch's stretch is read while this one is estimated and written (a cloud
         // in a scratch file: the disk reads ahead instead of waiting for each batch's faults).
@@ -95,29 +112,33 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
         if (end < roots) {
             readAhead(end, nextEnd);
         }
-        batch.clear();
+        Batch& batch = batches[slot]; // the writer is done with it: waited for below
+        batch.nodes.clear();
         std::size_t count = end - begin;
         for (int level = firstLevel; level < levelCount && count > 0; ++level) {
             std::size_t& first = next[static_cast<std::size_t>(level)];
             std::size_t children = 0;
             for (std::size_t i = first; i < first + count; ++i) {
-                batch.emplace_back(level, i);
+                batch.nodes.emplace_back(level, i);
                 children += hierarchy.node(level, i).childCount;
             }
             first += count;
             count = children;
         }
-        splats.resize(batch.size());
-        tbb::parallel_for(std::size_t{0}, batch.size(), [&](std::size_t b) {
-            hierarchy.nodeSplats(hierarchy.node(batch[b].first, batch[b].second), splats[b],
-                                 scratch.local());
+        batch.splats.resize(batch.nodes.size());
+        tbb::parallel_for(std::size_t{0}, batch.nodes.size(), [&](std::size_t b) {
+            const auto [level, index] = batch.nodes[b];
+            hierarchy.nodeSplats(hierarchy.node(level, index), batch.splats[b], scratch.local());
         });
-        for (std::size_t b = 0; b < batch.size(); ++b) {
-            const OctreeNode& node = hierarchy.node(batch[b].first, batch[b].second);
-            sinks[static_cast<std::size_t>(batch[b].first - firstLevel)].addNode(node, splats[b]);
+        if (writing.valid()) {
+            writing.get(); // the previous batch is written (or its error is thrown here)
         }
+        writing = std::async(std::launch::async, [&write, &batch] { write(batch); });
         begin = end;
         end = nextEnd;
+    }
+    if (writing.valid()) {
+        writing.get();
     }
     for (int level = firstLevel; level < levelCount; ++level) {
         levels[static_cast<std::size_t>(level)].payloadChecksum =

@@ -36,7 +36,9 @@ public:
     // Makes the file `size` bytes long (size >= bytesWritten()), its space reserved on disk
     // at once, so that regions beyond what was written sequentially can be filled with
     // writeAt in any order; write() continues at `size`. A disk without the room is an
-    // OutputError naming the bytes needed, before anything is written there.
+    // OutputError naming the bytes needed, before anything is written there. On a tmpfs the
+    // free space is checked and the region left sparse (reserving it there would zero its
+    // memory serially, before the writers could).
     void extendTo(std::uint64_t size);
 
     // For regions filled with writeAt: starts writing [offset, offset + count) back to disk,
