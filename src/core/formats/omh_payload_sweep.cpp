@@ -17,6 +17,84 @@ std::uint64_t coveredEnd(const OctreeNode& node) {
     return std::uint64_t{node.coveredBegin} + node.coveredCount;
 }
 
+// The writer's side of the sweep: the records of a batch's nodes, level run after level run,
+// cut into blocks of about 4 MiB that are encoded several at a time in parallel (TBB shares
+// the cores with the estimation of the next batch), then hashed and written in order by the
+// level's sink. Encoding, not writing, is most of a save's serial work; the blocks in flight
+// bound the memory it takes.
+class ParallelRecordEncoder {
+public:
+    ParallelRecordEncoder(const SortedCloud& cloud, const omh::RecordLayout& layout,
+                          std::vector<OmhRecordSink>& sinks, int firstLevel)
+        : m_cloud(cloud), m_layout(layout), m_sinks(sinks), m_firstLevel(firstLevel),
+          m_blockRecords(std::max<std::size_t>(1, kBlockBytes / layout.bytes)) {}
+
+    // Queues the records of every point `node` holds; `node` and `splats` must stay valid
+    // until finish().
+    void add(int level, const OctreeNode& node, const NodeSplats& splats) {
+        for (std::uint32_t p = 0; p < node.pointCount;) {
+            if (m_used == 0 || m_blocks[m_used - 1].level != level ||
+                m_blocks[m_used - 1].records == m_blockRecords) {
+                if (m_used == m_blocks.size()) {
+                    finish();
+                }
+                Block& opened = m_blocks[m_used++];
+                opened.level = level;
+                opened.records = 0;
+                opened.pieces.clear();
+            }
+            Block& block = m_blocks[m_used - 1];
+            const auto take = static_cast<std::uint32_t>(
+                std::min<std::size_t>(m_blockRecords - block.records, node.pointCount - p));
+            block.pieces.push_back({&node, &splats, p, p + take});
+            block.records += take;
+            p += take;
+        }
+    }
+
+    // Encodes what is queued, in parallel, and writes it in order.
+    void finish() {
+        tbb::parallel_for(std::size_t{0}, m_used, [&](std::size_t i) {
+            Block& block = m_blocks[i];
+            block.bytes.resize(block.records * m_layout.bytes);
+            std::uint8_t* out = block.bytes.data();
+            for (const Piece& piece : block.pieces) {
+                encodeOmhRecords(m_cloud, m_layout, *piece.node, *piece.splats, piece.first,
+                                 piece.last, out);
+                out += std::size_t{piece.last - piece.first} * m_layout.bytes;
+            }
+        });
+        for (std::size_t i = 0; i < m_used; ++i) {
+            const Block& block = m_blocks[i];
+            m_sinks[static_cast<std::size_t>(block.level - m_firstLevel)].addEncoded(
+                block.bytes.data(), block.bytes.size());
+        }
+        m_used = 0;
+    }
+
+private:
+    static constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
+    struct Piece {
+        const OctreeNode* node;
+        const NodeSplats* splats;
+        std::uint32_t first; // held points [first, last) of the node
+        std::uint32_t last;
+    };
+    struct Block {
+        int level = 0;
+        std::size_t records = 0;
+        std::vector<Piece> pieces;
+        std::vector<std::uint8_t> bytes;
+    };
+    const SortedCloud& m_cloud;
+    omh::RecordLayout m_layout;
+    std::vector<OmhRecordSink>& m_sinks;
+    int m_firstLevel;
+    std::size_t m_blockRecords;
+    std::array<Block, 8> m_blocks; // 32 MiB of records at most
+    std::size_t m_used = 0;
+};
+
 } // namespace
 
 SubtreePoints subtreeHeldPoints(const Hierarchy& hierarchy) {
@@ -52,7 +130,8 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
                               const omh::RecordLayout& layout, std::vector<omh::LevelEntry>& levels,
                               const SubtreePoints& subtrees, int firstLevel,
                               std::uint64_t maxBatchPoints,
-                              const std::function<void(int level)>& afterLevel) {
+                              const std::function<void(int level)>& afterLevel,
+                              const std::function<void(std::uint64_t readEnd)>& afterRead) {
     const SortedCloud& cloud = hierarchy.cloud();
     const int levelCount = hierarchy.maxLevel() + 1;
     std::vector<OmhRecordSink> sinks;
@@ -65,21 +144,23 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
     // order, so a batch's nodes at each level follow those of the level above: as many as
     // the batch's nodes there have children.
     std::vector<std::size_t> next(static_cast<std::size_t>(levelCount), 0);
-    // Two batches in flight: while a writer thread encodes, hashes and writes one (serial,
-    // and on a disk mostly waiting for it), the calling thread and TBB estimate the splat
-    // attributes of the next (parallel, and over a scratch file mostly waiting for its reads).
-    // Only the writer touches the sinks; both stages only read the hierarchy and the cloud.
+    // Two batches in flight: while a writer thread encodes (in parallel), hashes and writes
+    // (serially; on a disk mostly waiting for it) one, the calling thread and TBB estimate the
+    // splat attributes of the next (parallel, and over a scratch file mostly waiting for its
+    // reads). Only the writer touches the sinks and the encoder; both stages only read the
+    // hierarchy and the cloud.
     struct Batch {
         std::vector<std::pair<int, std::size_t>> nodes; // (level, index), level by level
         std::vector<NodeSplats> splats;
     };
     std::array<Batch, 2> batches;
+    ParallelRecordEncoder encoder(cloud, layout, sinks, firstLevel);
     const auto write = [&](const Batch& batch) {
         for (std::size_t b = 0; b < batch.nodes.size(); ++b) {
             const auto [level, index] = batch.nodes[b];
-            sinks[static_cast<std::size_t>(level - firstLevel)].addNode(
-                hierarchy.node(level, index), batch.splats[b]);
+            encoder.add(level, hierarchy.node(level, index), batch.splats[b]);
         }
+        encoder.finish(); // before the batch's splats are reused
     };
     std::future<void> writing; // of the previous batch; its destructor waits for it
     tbb::enumerable_thread_specific<SplatScratch> scratch;
@@ -130,6 +211,9 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
             const auto [level, index] = batch.nodes[b];
             hierarchy.nodeSplats(hierarchy.node(level, index), batch.splats[b], scratch.local());
         });
+        if (afterRead) { // the batch's pages are in memory: the estimation read them
+            afterRead(coveredEnd(hierarchy.node(firstLevel, end - 1)));
+        }
         if (writing.valid()) {
             writing.get(); // the previous batch is written (or its error is thrown here)
         }

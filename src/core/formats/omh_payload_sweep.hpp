@@ -34,11 +34,14 @@ int omhSweepFirstLevel(const SubtreePoints& subtrees, std::uint64_t maxBatchPoin
 // (the file extended past them), filling in their payload checksums; `afterLevel` is called
 // for each level once all its records were handed to the file. A batch of subtrees holds at
 // most `maxBatchPoints` points (their splat attributes wait in memory until written) unless
-// one subtree alone holds more.
+// one subtree alone holds more. `afterRead` (may be empty) is called on the calling thread
+// once a batch's stretch of the cloud has been read, with the stretch's end: the points before
+// it are in memory now (a built hierarchy's batches cover the cloud front to back).
 void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy,
                               const omh::RecordLayout& layout, std::vector<omh::LevelEntry>& levels,
                               const SubtreePoints& subtrees, int firstLevel,
                               std::uint64_t maxBatchPoints,
-                              const std::function<void(int level)>& afterLevel);
+                              const std::function<void(int level)>& afterLevel,
+                              const std::function<void(std::uint64_t readEnd)>& afterRead);
 
 } // namespace omicron

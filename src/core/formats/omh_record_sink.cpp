@@ -30,31 +30,48 @@ OmhRecordSink::OmhRecordSink(AtomicFileWriter& file, const SortedCloud& cloud,
     m_regionStart = m_at = offset;
 }
 
+namespace {
+
+void encodeRecord(const SortedCloud& cloud, const omh::RecordLayout& layout, std::uint32_t index,
+                  std::uint16_t encodedRadius, std::uint32_t estimatedNormal,
+                  std::uint8_t* record) {
+    const AttributeSet attributes = cloud.attributes();
+    storeRaw(record, cloud.position(index));
+    if (attributes.has(Attribute::Normal)) {
+        storeRaw(record + layout.point.normalOffset, cloud.normals()[index]);
+    }
+    if (attributes.has(Attribute::Color)) {
+        storeRaw(record + layout.point.colorOffset, cloud.color(index));
+    }
+    if (attributes.has(Attribute::Intensity)) {
+        storeRaw(record + layout.point.intensityOffset, cloud.intensities()[index]);
+    }
+    if (layout.point.lasBytes != 0) { // no LAS column: no record to copy from
+        std::memcpy(record + layout.point.lasOffset, cloud.lasRecord(index), layout.point.lasBytes);
+    }
+    storeRaw(record + layout.radiusOffset, encodedRadius);
+    if (layout.estimatedNormalOffset != 0) {
+        storeRaw(record + layout.estimatedNormalOffset, estimatedNormal);
+    }
+}
+
+} // namespace
+
+void encodeOmhRecords(const SortedCloud& cloud, const omh::RecordLayout& layout,
+                      const OctreeNode& node, const NodeSplats& splats, std::uint32_t first,
+                      std::uint32_t last, std::uint8_t* out) {
+    for (std::uint32_t p = first; p < last; ++p, out += layout.bytes) {
+        encodeRecord(cloud, layout, node.heldPoint(p), splats.radii[p],
+                     splats.normals.empty() ? 0u : splats.normals[p], out);
+    }
+}
+
 void OmhRecordSink::add(std::uint32_t index, std::uint16_t encodedRadius,
                         std::uint32_t estimatedNormal) {
     if (m_used == m_block.size()) {
         flush();
     }
-    std::uint8_t* record = m_block.data() + m_used;
-    const AttributeSet attributes = m_cloud.attributes();
-    storeRaw(record, m_cloud.position(index));
-    if (attributes.has(Attribute::Normal)) {
-        storeRaw(record + m_layout.point.normalOffset, m_cloud.normals()[index]);
-    }
-    if (attributes.has(Attribute::Color)) {
-        storeRaw(record + m_layout.point.colorOffset, m_cloud.color(index));
-    }
-    if (attributes.has(Attribute::Intensity)) {
-        storeRaw(record + m_layout.point.intensityOffset, m_cloud.intensities()[index]);
-    }
-    if (m_layout.point.lasBytes != 0) { // no LAS column: no record to copy from
-        std::memcpy(record + m_layout.point.lasOffset, m_cloud.lasRecord(index),
-                    m_layout.point.lasBytes);
-    }
-    storeRaw(record + m_layout.radiusOffset, encodedRadius);
-    if (m_layout.estimatedNormalOffset != 0) {
-        storeRaw(record + m_layout.estimatedNormalOffset, estimatedNormal);
-    }
+    encodeRecord(m_cloud, m_layout, index, encodedRadius, estimatedNormal, m_block.data() + m_used);
     m_used += m_layout.bytes;
 }
 
@@ -62,6 +79,11 @@ void OmhRecordSink::addNode(const OctreeNode& node, const NodeSplats& splats) {
     for (std::uint32_t p = 0; p < node.pointCount; ++p) {
         add(node.heldPoint(p), splats.radii[p], splats.normals.empty() ? 0u : splats.normals[p]);
     }
+}
+
+void OmhRecordSink::addEncoded(const std::uint8_t* records, std::size_t bytes) {
+    flush();
+    write(records, bytes);
 }
 
 std::uint64_t OmhRecordSink::finishSection() {
@@ -75,18 +97,21 @@ std::uint64_t OmhRecordSink::finishSection() {
 }
 
 void OmhRecordSink::flush() {
-    if (m_used == 0) {
-        return;
-    }
-    m_checksum->update(m_block.data(), m_used);
-    if (!m_positional) {
-        m_file.write(m_block.data(), m_used);
-        m_used = 0;
-        return;
-    }
-    m_file.writeAt(m_at, m_block.data(), m_used);
-    m_at += m_used;
+    write(m_block.data(), m_used);
     m_used = 0;
+}
+
+void OmhRecordSink::write(const std::uint8_t* records, std::size_t bytes) {
+    if (bytes == 0) {
+        return;
+    }
+    m_checksum->update(records, bytes);
+    if (!m_positional) {
+        m_file.write(records, bytes);
+        return;
+    }
+    m_file.writeAt(m_at, records, bytes);
+    m_at += bytes;
     // Two complete windows behind the write position: start the newer's write-back, wait for
     // the older's and drop it. At most two windows of each region stay cached.
     while (m_at - m_regionStart >= m_released + 2 * kCacheWindowBytes) {

@@ -17,6 +17,13 @@
 
 namespace omicron {
 
+// Encodes the records of `node`'s held points [first, last) with their splat attributes into
+// `out` ((last - first) * layout.bytes bytes): the work of OmhRecordSink::addNode, callable on
+// any thread, so that a level's records can be encoded in parallel and written in order.
+void encodeOmhRecords(const SortedCloud& cloud, const omh::RecordLayout& layout,
+                      const OctreeNode& node, const NodeSplats& splats, std::uint32_t first,
+                      std::uint32_t last, std::uint8_t* out);
+
 class OmhRecordSink {
 public:
     // Appends to `file`.
@@ -33,11 +40,16 @@ public:
     // Every point `node` holds, with the node's splat attributes, in order.
     void addNode(const OctreeNode& node, const NodeSplats& splats);
 
+    // Records encoded elsewhere (encodeOmhRecords), in order after what was added before.
+    void addEncoded(const std::uint8_t* records, std::size_t bytes);
+
     // Writes what is pending and returns the checksum of everything since the last call.
     std::uint64_t finishSection();
 
 private:
     void flush();
+    // Hashes `bytes` and writes them after what was written before.
+    void write(const std::uint8_t* records, std::size_t bytes);
 
     AtomicFileWriter& m_file;
     const SortedCloud& m_cloud;

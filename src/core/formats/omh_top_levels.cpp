@@ -5,17 +5,8 @@
 
 namespace omicron {
 
-namespace {
-
-// A window whose gathered points are at least one per this many of its points is read ahead
-// whole (a pick every two pages of 12-byte positions, as the sweep's rule); sparser windows
-// fault in only the pages they use.
-constexpr std::uint64_t kDenseStridePoints = 680;
-
-} // namespace
-
-std::unique_ptr<TopLevelPoints> TopLevelPoints::gather(const Hierarchy& hierarchy, int levels,
-                                                       std::uint64_t maxBytes) {
+std::unique_ptr<TopLevelPoints> TopLevelPoints::plan(const Hierarchy& hierarchy, int levels,
+                                                     std::uint64_t maxBytes) {
     const SortedCloud& source = hierarchy.cloud();
     const AttributeSet attributes = source.attributes();
     std::uint64_t held = 0;
@@ -60,47 +51,49 @@ std::unique_ptr<TopLevelPoints> TopLevelPoints::gather(const Hierarchy& hierarch
         }
     }
 
-    // One pass front to back over the source, a window at a time: read ahead where the
-    // window is dense in gathered points, copied, and released under the budget.
     top->m_cloud = std::make_shared<SortedCloud>(source.cube(), source.sourceOffset(), attributes,
                                                  points.size());
-    SortedCloud& cloud = *top->m_cloud;
-    const std::size_t lasBytes = attributes.lasBytes();
-    const std::uint64_t window =
-        std::max<std::uint64_t>(1, source.residentBudget() / 8 / pointBytes(attributes));
-    for (std::size_t begin = 0; begin < points.size();) {
-        const std::uint64_t windowEnd = std::uint64_t{points[begin]} + window;
-        const std::size_t end = static_cast<std::size_t>(
-            std::lower_bound(points.begin() + static_cast<std::ptrdiff_t>(begin), points.end(),
-                             windowEnd) -
-            points.begin());
-        if ((end - begin) * kDenseStridePoints >= window) {
-            source.willRead(points[begin], points[end - 1] + 1);
-        }
-        const SortedCloud::StagedRange out = cloud.stage(end);
-        for (std::size_t i = begin; i < end; ++i) {
-            const std::uint32_t from = points[i];
-            const std::size_t to = i - begin;
-            out.positions[to] = source.position(from);
-            if (!out.normals.empty()) {
-                out.normals[to] = source.normals()[from];
-            }
-            if (!out.colors.empty()) {
-                out.colors[to] = source.color(from);
-            }
-            if (!out.intensities.empty()) {
-                out.intensities[to] = source.intensities()[from];
-            }
-            if (lasBytes != 0) {
-                std::memcpy(out.las.data() + to * lasBytes, source.lasRecord(from), lasBytes);
-            }
-        }
-        cloud.publish(end);
-        source.keepWithinBudget();
-        begin = end;
-    }
-    cloud.markComplete();
+    top->m_points = std::move(points);
     return top;
+}
+
+void TopLevelPoints::copyUpTo(std::uint64_t end) {
+    const SortedCloud& source = m_hierarchy.cloud();
+    SortedCloud& cloud = *m_cloud;
+    const std::size_t lasBytes = source.attributes().lasBytes();
+    const auto last = static_cast<std::size_t>(
+        std::lower_bound(m_points.begin() + static_cast<std::ptrdiff_t>(m_copied), m_points.end(),
+                         end) -
+        m_points.begin());
+    if (last == m_copied) {
+        return;
+    }
+    const SortedCloud::StagedRange out = cloud.stage(last);
+    for (std::size_t i = m_copied; i < last; ++i) {
+        const std::uint32_t from = m_points[i];
+        const std::size_t to = i - m_copied;
+        out.positions[to] = source.position(from);
+        if (!out.normals.empty()) {
+            out.normals[to] = source.normals()[from];
+        }
+        if (!out.colors.empty()) {
+            out.colors[to] = source.color(from);
+        }
+        if (!out.intensities.empty()) {
+            out.intensities[to] = source.intensities()[from];
+        }
+        if (lasBytes != 0) {
+            std::memcpy(out.las.data() + to * lasBytes, source.lasRecord(from), lasBytes);
+        }
+    }
+    cloud.publish(last);
+    m_copied = last;
+}
+
+void TopLevelPoints::finish() {
+    copyUpTo(UINT64_MAX);
+    m_cloud->markComplete();
+    m_points = {};
 }
 
 OctreeNode TopLevelPoints::node(int level, std::size_t index) const {

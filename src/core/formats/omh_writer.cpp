@@ -141,6 +141,39 @@ void copyPagedSource(const std::string& path, const std::string& source) {
     out.commit();
 }
 
+// Levels [0, levels) from the gathered copy of their points, each at its offset in the file
+// (already extended past them), filling in their payload checksums.
+void writeTopLevelsFromCopy(AtomicFileWriter& file, const Hierarchy& hierarchy,
+                            const TopLevelPoints& top, const omh::RecordLayout& layout,
+                            std::vector<omh::LevelEntry>& entries, int levels,
+                            const std::function<void(int level)>& afterLevel) {
+    tbb::enumerable_thread_specific<SplatScratch> scratch;
+    for (int level = 0; level < levels; ++level) {
+        omh::LevelEntry& entry = entries[static_cast<std::size_t>(level)];
+        OmhRecordSink sink(file, top.cloud(), layout, entry.payloadOffset);
+        std::vector<OctreeNode> nodes(entry.nodes);
+        std::vector<NodeSplats> levelSplats(entry.nodes);
+        tbb::parallel_for(std::size_t{0}, entry.nodes, [&](std::size_t i) {
+            nodes[i] = top.node(level, i);
+            const OctreeNode& node = hierarchy.node(level, i);
+            if (node.pointCount < kMinPointsPerSplatEstimate) {
+                // Borrows its shape from its covered range in the source: read in place.
+                hierarchy.nodeSplats(node, levelSplats[i], scratch.local());
+            } else {
+                estimateNodeSplats(top.cloud(), nodes[i], SparseSplatRegion{},
+                                   hierarchy.estimatesNormals(), levelSplats[i], scratch.local());
+            }
+        });
+        for (std::size_t i = 0; i < entry.nodes; ++i) {
+            sink.addNode(nodes[i], levelSplats[i]);
+        }
+        entry.payloadChecksum = sink.finishSection();
+        if (afterLevel) {
+            afterLevel(level);
+        }
+    }
+}
+
 } // namespace
 
 void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::BuildInfo& build,
@@ -246,48 +279,40 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
         options.sweepBatchPoints > 0 ? options.sweepBatchPoints : defaultBatch;
     const SubtreePoints subtrees = subtreeHeldPoints(hierarchy);
     const int firstSweptLevel = omhSweepFirstLevel(subtrees, sweepBatch);
-    // Over a scratch file, the top levels' points are copied out in one pass first.
+    // Over a scratch file, the top levels' points are copied out as the sweep reads the file,
+    // and the top levels are written after it, at their offsets.
     const std::unique_ptr<TopLevelPoints> top =
         options.gatherTopLevels && cloud.fileBacked() && firstSweptLevel > 0
-            ? TopLevelPoints::gather(hierarchy, firstSweptLevel, cloud.residentBudget() / 8)
+            ? TopLevelPoints::plan(hierarchy, firstSweptLevel, cloud.residentBudget() / 8)
             : nullptr;
-    OmhRecordSink sink(file, top ? top->cloud() : cloud, layout);
-    NodeSplatBatches splats(hierarchy);
-    tbb::enumerable_thread_specific<SplatScratch> scratch;
-    for (int level = 0; level < firstSweptLevel; ++level) {
-        omh::LevelEntry& entry = header.levels[static_cast<std::size_t>(level)];
-        if (top) {
-            std::vector<OctreeNode> nodes(entry.nodes);
-            std::vector<NodeSplats> levelSplats(entry.nodes);
-            tbb::parallel_for(std::size_t{0}, entry.nodes, [&](std::size_t i) {
-                nodes[i] = top->node(level, i);
-                const OctreeNode& node = hierarchy.node(level, i);
-                if (node.pointCount < kMinPointsPerSplatEstimate) {
-                    // Borrows its shape from its covered range in the source: read in place.
-                    hierarchy.nodeSplats(node, levelSplats[i], scratch.local());
-                } else {
-                    estimateNodeSplats(top->cloud(), nodes[i], SparseSplatRegion{},
-                                       hierarchy.estimatesNormals(), levelSplats[i],
-                                       scratch.local());
-                }
-            });
-            for (std::size_t i = 0; i < entry.nodes; ++i) {
-                sink.addNode(nodes[i], levelSplats[i]);
-            }
-        } else {
+    const omh::LevelEntry& deepest = header.levels.back();
+    const std::uint64_t payloadEnd = deepest.payloadOffset + deepest.points * layout.bytes;
+    if (top) {
+        file.extendTo(payloadEnd);
+        writeOmhLevelsInOneSweep(file, hierarchy, layout, header.levels, subtrees, firstSweptLevel,
+                                 sweepBatch, options.afterLevel,
+                                 [&](std::uint64_t readEnd) { top->copyUpTo(readEnd); });
+        top->finish();
+        writeTopLevelsFromCopy(file, hierarchy, *top, layout, header.levels, firstSweptLevel,
+                               options.afterLevel);
+    } else {
+        // The top levels a level at a time, appended; their points are few.
+        OmhRecordSink sink(file, cloud, layout);
+        NodeSplatBatches splats(hierarchy);
+        for (int level = 0; level < firstSweptLevel; ++level) {
+            omh::LevelEntry& entry = header.levels[static_cast<std::size_t>(level)];
             for (std::size_t i = 0; i < entry.nodes; ++i) {
                 sink.addNode(hierarchy.node(level, i), splats.of(level, i));
             }
+            entry.payloadChecksum = sink.finishSection();
+            if (options.afterLevel) {
+                options.afterLevel(level);
+            }
         }
-        entry.payloadChecksum = sink.finishSection();
-        if (options.afterLevel) {
-            options.afterLevel(level);
-        }
+        file.extendTo(payloadEnd);
+        writeOmhLevelsInOneSweep(file, hierarchy, layout, header.levels, subtrees, firstSweptLevel,
+                                 sweepBatch, options.afterLevel, nullptr);
     }
-    const omh::LevelEntry& deepest = header.levels.back();
-    file.extendTo(deepest.payloadOffset + deepest.points * layout.bytes);
-    writeOmhLevelsInOneSweep(file, hierarchy, layout, header.levels, subtrees, firstSweptLevel,
-                             sweepBatch, options.afterLevel);
 
     const auto footerBytes = omh::encodeFooter(header.totalNodes, header.totalPoints);
     file.write(footerBytes.data(), footerBytes.size());

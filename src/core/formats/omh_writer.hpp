@@ -14,17 +14,18 @@
 namespace omicron {
 
 struct OmhWriteOptions {
-    // Called after each level's point records were handed to the file (level 0 first). For
-    // progress, and for the test that kills a save half-way (see omicron-cli build --save).
+    // Called once for each level after its point records were handed to the file: the top
+    // levels from level 0 and then the swept ones, or, over a cloud in a scratch file, the
+    // swept levels first. For the test that kills a save half-way (omicron-cli build --save).
     std::function<void(int level)> afterLevel;
     // Points held by a batch of the one-pass sweep that writes the deep levels (0: the
     // default, 4 Mi; for a cloud in a scratch file at most an eighth of the budget's worth, or a
     // 32nd of it when that is more). The
     // bytes written do not depend on it; tests vary it.
     std::uint64_t sweepBatchPoints = 0;
-    // Over a cloud in a scratch file, copy the top levels' points out in one pass before
-    // writing them (omh_top_levels.hpp) rather than read them in place. The bytes written do
-    // not depend on it; tests turn it off.
+    // Over a cloud in a scratch file, copy the top levels' points out while the sweep reads
+    // the file and write them afterwards (omh_top_levels.hpp) rather than read them in place.
+    // The bytes written do not depend on it; tests turn it off.
     bool gatherTopLevels = true;
 };
 

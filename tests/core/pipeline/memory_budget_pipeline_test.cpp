@@ -147,29 +147,42 @@ TEST(BudgetedBuild, ASortedStreamBeyondTheBudgetStreamsIntoAFileBackedCloud) {
 }
 
 // A save over a cloud in a scratch file writes the in-memory build's bytes, whether the top
-// levels' points are copied out in one pass first or read in place, for sweep batches from one
-// point (every level but the deepest above the sweep) to the whole hierarchy.
+// levels' points are copied out while the sweep reads the file or read in place, for sweep
+// batches from one point (every level but the deepest above the sweep) to the whole
+// hierarchy, and with leaves collapsed (a collapsed leaf's points lie under no swept subtree:
+// they are copied between two batches' stretches).
 TEST(BudgetedBuild, SaveOverTheScratchFileWritesTheInMemoryBytes) {
     OMICRON_REQUIRE_SHARED_FILE(path, "lion.ply");
     test::TempDir scratch;
-    BuildPipeline inMemory;
-    const PipelineResult run = inMemory.run(path, options(0, scratch.path().string()));
-    const omh::BuildInfo info = omhBuildInfo(options(0, "").build, run.stats);
-    const std::string reference = scratch.file("reference.omh");
-    writeOmh(reference, *inMemory.hierarchy(), info);
-    BuildPipeline budgeted;
-    budgeted.run(path, options(kMinMemoryBudget, scratch.path().string()));
-    ASSERT_TRUE(budgeted.sortedCloud()->fileBacked());
-    for (const bool gather : {true, false}) {
-        for (const std::uint64_t batch :
-             {std::uint64_t{1}, std::uint64_t{5'000}, std::uint64_t{0}, std::uint64_t{1} << 40}) {
-            SCOPED_TRACE(std::string(gather ? "gathered" : "in place") + ", batch " +
-                         std::to_string(batch));
-            OmhWriteOptions write;
-            write.gatherTopLevels = gather;
-            write.sweepBatchPoints = batch;
-            writeOmh(scratch.file("budgeted.omh"), *budgeted.hierarchy(), info, write);
-            EXPECT_EQ(test::readBytes(scratch.file("budgeted.omh")), test::readBytes(reference));
+    for (const LeafCollapse collapse : {LeafCollapse::Off, LeafCollapse::Paper}) {
+        SCOPED_TRACE(collapse == LeafCollapse::Off ? "no collapse" : "paper collapse");
+        BuildPipeline inMemory;
+        const PipelineResult run =
+            inMemory.run(path, options(0, scratch.path().string(), collapse));
+        const omh::BuildInfo info = omhBuildInfo(options(0, "", collapse).build, run.stats);
+        const std::string reference = scratch.file("reference.omh");
+        writeOmh(reference, *inMemory.hierarchy(), info);
+        BuildPipeline budgeted;
+        budgeted.run(path, options(kMinMemoryBudget, scratch.path().string(), collapse));
+        ASSERT_TRUE(budgeted.sortedCloud()->fileBacked());
+        for (const bool gather : {true, false}) {
+            for (const std::uint64_t batch : {std::uint64_t{1}, std::uint64_t{5'000},
+                                              std::uint64_t{0}, std::uint64_t{1} << 40}) {
+                SCOPED_TRACE(std::string(gather ? "gathered" : "in place") + ", batch " +
+                             std::to_string(batch));
+                OmhWriteOptions write;
+                write.gatherTopLevels = gather;
+                write.sweepBatchPoints = batch;
+                std::vector<int> levelsWritten;
+                write.afterLevel = [&](int level) {
+                    levelsWritten.push_back(level);
+                };
+                writeOmh(scratch.file("budgeted.omh"), *budgeted.hierarchy(), info, write);
+                EXPECT_EQ(test::readBytes(scratch.file("budgeted.omh")),
+                          test::readBytes(reference));
+                std::sort(levelsWritten.begin(), levelsWritten.end());
+                EXPECT_EQ(levelsWritten, (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));
+            }
         }
     }
 }
