@@ -18,7 +18,7 @@ std::uint64_t coveredEnd(const OctreeNode& node) {
 }
 
 // The writer's side of the sweep: the records of a batch's nodes, level run after level run,
-// cut into blocks of about 4 MiB that are encoded several at a time in parallel (TBB shares
+// cut into blocks of about 1 MiB that are encoded several at a time in parallel (TBB shares
 // the cores with the estimation of the next batch), then hashed and written in order by the
 // level's sink. Encoding, not writing, is most of a save's serial work; the blocks in flight
 // bound the memory it takes.
@@ -73,7 +73,7 @@ public:
     }
 
 private:
-    static constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
+    static constexpr std::size_t kBlockBytes = std::size_t{1} << 20;
     struct Piece {
         const OctreeNode* node;
         const NodeSplats* splats;
@@ -91,7 +91,7 @@ private:
     std::vector<OmhRecordSink>& m_sinks;
     int m_firstLevel;
     std::size_t m_blockRecords;
-    std::array<Block, 8> m_blocks; // 32 MiB of records at most
+    std::array<Block, 8> m_blocks; // 8 MiB of records at most
     std::size_t m_used = 0;
 };
 

@@ -20,7 +20,6 @@ constexpr std::uint64_t kCacheWindowBytes = std::uint64_t{64} << 20;
 OmhRecordSink::OmhRecordSink(AtomicFileWriter& file, const SortedCloud& cloud,
                              const omh::RecordLayout& layout)
     : m_file(file), m_cloud(cloud), m_layout(layout),
-      m_block(std::max<std::size_t>(1, kBlockBytes / layout.bytes) * layout.bytes),
       m_checksum(std::make_unique<oms::PayloadChecksum>()) {}
 
 OmhRecordSink::OmhRecordSink(AtomicFileWriter& file, const SortedCloud& cloud,
@@ -70,6 +69,9 @@ void OmhRecordSink::add(std::uint32_t index, std::uint16_t encodedRadius,
                         std::uint32_t estimatedNormal) {
     if (m_used == m_block.size()) {
         flush();
+        if (m_block.empty()) { // first use: a sink fed only encoded blocks never needs it
+            m_block.resize(std::max<std::size_t>(1, kBlockBytes / m_layout.bytes) * m_layout.bytes);
+        }
     }
     encodeRecord(m_cloud, m_layout, index, encodedRadius, estimatedNormal, m_block.data() + m_used);
     m_used += m_layout.bytes;
