@@ -16,7 +16,12 @@
 //   mb_per_s=... raw_mb_per_s=... ratio_vs_raw=...
 // phase=open_and_read includes the bounds pre-pass of formats whose header has no bounds;
 // phase=parse passes the bounds in (OpenOptions::knownBounds), so it is the streaming parse.
+// The same points sorted into a .oms (pipeline 2's input) are measured too, reader=oms
+// phase=parse: OmsReader streaming the records into its cloud, each range's codes recomputed
+// and checked for order, and the payload checksum (a FILE that is a .oms is measured alone).
 #include "bench_timing.hpp"
+#include "formats/oms_reader.hpp"
+#include "formats/oms_writer.hpp"
 #include "io/file_stream.hpp"
 #include "io/las/las_header.hpp"
 #include "io/las/las_writer.hpp"
@@ -87,6 +92,38 @@ void measure(const std::string& label, const std::string& path, int runs) {
                     points / s / 1e6, bytes / s / 1e6, rawMbPerS, rawS / s);
     }
     std::fflush(stdout);
+}
+
+// A .oms into its sorted cloud, as `build IN.oms` reads it (without the builder).
+void measureOms(const std::string& path, int runs) {
+    const std::uint64_t bytes = std::filesystem::file_size(path);
+    rawRead(path); // warm the page cache
+    const double rawS = bestSeconds(runs, [&] { rawRead(path); });
+    std::uint64_t points = 0;
+    const double parseS = bestSeconds(runs, [&] {
+        omicron::OmsReader reader(path);
+        points = 0;
+        reader.read([&](const omicron::SortedCloud&, std::size_t begin, std::size_t end) {
+            points += end - begin;
+        });
+    });
+    std::printf("bench=read reader=oms phase=parse points=%llu bytes=%llu bytes_per_point=%.1f "
+                "ms=%.1f mpoints_per_s=%.2f mb_per_s=%.1f raw_mb_per_s=%.1f ratio_vs_raw=%.3f\n",
+                static_cast<unsigned long long>(points), static_cast<unsigned long long>(bytes),
+                double(bytes) / double(points), parseS * 1e3, points / parseS / 1e6,
+                bytes / parseS / 1e6, bytes / rawS / 1e6, rawS / parseS);
+    std::fflush(stdout);
+}
+
+// Sorts `input` into `oms` (pipeline 1; the cloud is written once sorted).
+void sortInto(const std::string& input, const std::string& oms) {
+    auto reader = omicron::openPointCloud(input);
+    std::shared_ptr<const omicron::SortedCloud> cloud;
+    const omicron::SortSummary sorted = omicron::sortPointCloud(
+        *reader, omicron::SortOptions{},
+        [](const omicron::SortedCloud&, std::size_t, std::size_t) {},
+        [&](const omicron::IncrementalMortonSorter& sorter) { cloud = sorter.cloud(); });
+    omicron::writeOms(oms, *cloud, sorted.points);
 }
 
 std::string label(omicron::CloudFormat format) {
@@ -237,6 +274,10 @@ int main(int argc, char** argv) {
     const std::string input = argv[1];
     const bool keepTemp = argc > 2 && std::strcmp(argv[2], "--keep-temp") == 0;
     try {
+        if (omicron::isOmsFile(input)) {
+            measureOms(input, 3);
+            return 0;
+        }
         measure(label(omicron::detectFormat(input)), input, 3);
 
         const omicron::LoadedCloud cloud = omicron::loadPointCloud(input);
@@ -266,6 +307,8 @@ int main(int argc, char** argv) {
         for (const char* name : {"big_endian.ply", "cloud.las", "ascii.ply", "cloud.xyz"}) {
             measure(label(omicron::detectFormat(file(name))), file(name), 2);
         }
+        sortInto(input, file("cloud.oms"));
+        measureOms(file("cloud.oms"), 2);
         if (!keepTemp) {
             std::filesystem::remove_all(folder);
         }
