@@ -3,11 +3,11 @@
 #include "io/point_reader.hpp"
 #include "points/morton.hpp"
 #include "run_process.hpp"
+#include "std_regex.hpp"
 #include "test_files.hpp"
 
 #include <algorithm>
 #include <gtest/gtest.h>
-#include <regex>
 
 namespace omicron {
 namespace {

@@ -2,13 +2,13 @@
 // a saved hierarchy; every input point once (the counts it prints and metadata.json's); clear
 // errors naming the file; Ctrl+C half-way leaves neither the folder nor a temporary one.
 #include "run_process.hpp"
+#include "std_regex.hpp"
 #include "test_files.hpp"
 
 #include <chrono>
 #include <csignal>
 #include <filesystem>
 #include <gtest/gtest.h>
-#include <regex>
 #include <thread>
 
 namespace omicron {

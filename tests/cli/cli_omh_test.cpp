@@ -1,14 +1,13 @@
 // omicron-cli build --save / info on .omh files, driven as a user would: the per-level counts
 // agree, --verify catches damage, and a save killed half-way leaves the old file usable.
 #include "run_process.hpp"
+#include "std_regex.hpp"
 #include "test_files.hpp"
-
-#include <gtest/gtest.h>
 
 #include <chrono>
 #include <filesystem>
 #include <fstream>
-#include <regex>
+#include <gtest/gtest.h>
 #include <sstream>
 #include <thread>
 

@@ -8,13 +8,13 @@
 // cloud. Skipped, with the reason, where node, Chromium or the npm packages are missing
 // (scripts/build.sh installs them).
 #include "run_process.hpp"
+#include "std_regex.hpp"
 #include "test_files.hpp"
 
 #include <cstdlib>
 #include <filesystem>
 #include <gtest/gtest.h>
 #include <ostream>
-#include <regex>
 #include <sstream>
 #include <unistd.h>
 

@@ -86,8 +86,11 @@ void expectFrontPointsEqual(const Front& front, const Hierarchy& paged, const Hi
                 ASSERT_EQ(a.colors()[i], b.colors()[i]);
             }
             const std::size_t lasBytes = a.attributes().lasBytes();
-            ASSERT_EQ(std::memcmp(a.lasRecord(i), b.lasRecord(i), lasBytes), 0)
-                << "the LAS fields of level " << level << " node " << entry.index << " point " << p;
+            if (lasBytes != 0) { // no LAS column: no record to compare (and memcmp of null)
+                ASSERT_EQ(std::memcmp(a.lasRecord(i), b.lasRecord(i), lasBytes), 0)
+                    << "the LAS fields of level " << level << " node " << entry.index
+                    << " point " << p;
+            }
         }
         paged.nodeSplats(node, pagedSplats, scratch);
         whole.nodeSplats(whole.node(level, entry.index), wholeSplats, scratch);

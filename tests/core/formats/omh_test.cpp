@@ -90,8 +90,10 @@ void expectSameHierarchy(const Hierarchy& built, const Hierarchy& loaded) {
                     ASSERT_EQ(a.intensities()[u], b.intensities()[v]);
                 }
                 const std::size_t lasBytes = a.attributes().lasBytes();
-                ASSERT_EQ(std::memcmp(a.lasRecord(u), b.lasRecord(v), lasBytes), 0)
-                    << "the LAS fields of held point " << p;
+                if (lasBytes != 0) { // no LAS column: nothing to compare (and memcmp of null)
+                    ASSERT_EQ(std::memcmp(a.lasRecord(u), b.lasRecord(v), lasBytes), 0)
+                        << "the LAS fields of held point " << p;
+                }
             }
         }
     }

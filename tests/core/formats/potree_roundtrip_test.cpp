@@ -10,6 +10,7 @@
 #include "formats/omh_writer.hpp"
 #include "formats/potree_writer.hpp"
 #include "hierarchy_test_support.hpp"
+#include "std_regex.hpp"
 #include "test_files.hpp"
 
 #include <algorithm>
@@ -19,7 +20,6 @@
 #include <deque>
 #include <filesystem>
 #include <gtest/gtest.h>
-#include <regex>
 #include <tuple>
 
 namespace omicron::test {

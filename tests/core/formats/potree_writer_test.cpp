@@ -5,6 +5,7 @@
 // decoded points with the input; the CLI tests load the folder in a real Potree client.
 #include "formats/potree_writer.hpp"
 #include "hierarchy_test_support.hpp"
+#include "std_regex.hpp"
 #include "test_files.hpp"
 
 #include <atomic>
@@ -12,7 +13,6 @@
 #include <deque>
 #include <filesystem>
 #include <gtest/gtest.h>
-#include <regex>
 
 namespace omicron::test {
 namespace {
