@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The AddressSanitizer + LeakSanitizer job (outside the default suite: an instrumented build
 # of the core, the viewer and the application takes a long time on CI). Builds the `asan`
-# preset (ASan + UBSan, invariant checkers on) for the tests of cancelling and closing while a
+# preset (ASan + UBSan, invariant checkers on) for the whole core suite (omicron_core_tests:
+# readers, sorter, builder, saves and loads, each with its threads), the tests of cancelling
+# and closing while a
 # build runs, and runs them under Xvfb with leak detection: tst_builderservice (cancel, also
 # during a file's bounds pre-pass; destruction mid-build), tst_mainwindowGL (close mid-build,
 # open, rebuild, save, errors), the hierarchy tree's tests, which read a hierarchy while a
@@ -16,8 +18,8 @@ source scripts/common.sh
 omicron_install_packages
 
 tests=("$@")
-[ "${#tests[@]}" -eq 0 ] && tests=(tst_builderservice tst_mainwindowGL tst_hierarchymodel tst_cutpanel
-  tst_cloudview_gl tst_computepoints_gl)
+[ "${#tests[@]}" -eq 0 ] && tests=(omicron_core_tests tst_builderservice tst_mainwindowGL
+  tst_hierarchymodel tst_cutpanel tst_cloudview_gl tst_computepoints_gl)
 
 cmake --preset asan >/dev/null
 cmake --build --preset asan --target "${tests[@]}"
