@@ -2,19 +2,19 @@
 // pixel statistics of renderImage() from fixed cameras.
 #include "build/hierarchy_builder.hpp"
 #include "cloud_view.hpp"
-#include "scale_bar.hpp"
 #include "formats/omh_writer.hpp"
 #include "io/las/las_writer.hpp"
 #include "io/point_reader.hpp"
 #include "pipeline/build_pipeline.hpp"
+#include "scale_bar.hpp"
 #include "sort/morton_sorter.hpp"
 #include "widget_test_support.hpp"
 
 #include <QElapsedTimer>
 #include <QFile>
-#include <QTextStream>
 #include <QSignalSpy>
 #include <QTemporaryDir>
+#include <QTextStream>
 #include <QtTest>
 #include <cmath>
 
@@ -225,7 +225,8 @@ private slots:
         for (const auto& [i, j] : {std::pair{7, 11}, std::pair{0, 0}, std::pair{19, 3}}) {
             const auto picked = view.pickCloudPoint(
                 pixelOf(view, *hierarchy, glm::dvec3(500000.0 + i, 4000000.0 + j, 100.0)));
-            QVERIFY2(picked.has_value(), qPrintable(QStringLiteral("grid point %1 %2").arg(i).arg(j)));
+            QVERIFY2(picked.has_value(),
+                     qPrintable(QStringLiteral("grid point %1 %2").arg(i).arg(j)));
             QVERIFY2(std::abs(picked->source.x - (500000.0 + i)) < 1e-3 &&
                          std::abs(picked->source.y - (4000000.0 + j)) < 1e-3 &&
                          std::abs(picked->source.z - 100.0) < 1e-3,
@@ -302,7 +303,9 @@ private slots:
         view.finishMeasurement();
         QCOMPARE(view.measurements().size(), std::size_t{4});
         QVERIFY2(std::abs(view.measurements()[3].value() - 100.0) < kTolerance,
-                 qPrintable(view.measurements()[3].valueText() + QStringLiteral(" from %1 points").arg(view.measurements()[3].points.size())));
+                 qPrintable(
+                     view.measurements()[3].valueText() +
+                     QStringLiteral(" from %1 points").arg(view.measurements()[3].points.size())));
         QVERIFY(view.measurements()[3].valueText().startsWith(QStringLiteral("100.000")));
 
         // Over empty space a click adds nothing; Escape drops an unfinished one.
@@ -339,8 +342,8 @@ private slots:
             RenderSettings settings = plainSettings();
             settings.mode = mode;
             // Columns 0..9 (x up to 500009.5), turned by a quarter turn: its x along +y.
-            settings.clip = ClipBox{{500004.75, 4000009.5, 100.0}, {10.0, 4.75, 1.0},
-                                    std::acos(-1.0) / 2.0};
+            settings.clip =
+                ClipBox{{500004.75, 4000009.5, 100.0}, {10.0, 4.75, 1.0}, std::acos(-1.0) / 2.0};
             view.setRenderSettings(settings);
             view.update();
             QTRY_VERIFY(view.lastFrameStats().pointsDrawn > 0);
@@ -349,8 +352,7 @@ private slots:
             for (int j : {2, 10, 17}) {
                 const auto inside = view.pickCloudPoint(
                     pixelOf(view, *hierarchy, glm::dvec3(500003.0, 4000000.0 + j, 100.0)));
-                QVERIFY2(inside && std::abs(inside->source.x - 500003.0) < 1e-3,
-                         qPrintable(trace));
+                QVERIFY2(inside && std::abs(inside->source.x - 500003.0) < 1e-3, qPrintable(trace));
                 const auto outside = view.pickCloudPoint(
                     pixelOf(view, *hierarchy, glm::dvec3(500016.0, 4000000.0 + j, 100.0)));
                 QVERIFY2(!outside || outside->source.x < 500010.0,
@@ -403,7 +405,8 @@ private slots:
             }
             return std::pair{bottom[0] - top[0], bottom[1] - top[1]};
         };
-        const auto [redPerspective, greenPerspective] = screenHeights(view.renderImage(QSize(400, 400)));
+        const auto [redPerspective, greenPerspective] =
+            screenHeights(view.renderImage(QSize(400, 400)));
         QVERIFY(!view.orthographic());
         view.setOrthographic(true);
         QVERIFY(view.orthographic());
@@ -462,7 +465,8 @@ private slots:
             }
             return changed;
         };
-        const QRect bottomRight(300, 340, 100, 60), topRight(330, 0, 70, 80), middle(100, 100, 200, 200);
+        const QRect bottomRight(300, 340, 100, 60), topRight(330, 0, 70, 80),
+            middle(100, 100, 200, 200);
         RenderSettings settings = plainSettings();
         view.setRenderSettings(settings);
         const QImage none = view.renderImage(QSize(400, 400));

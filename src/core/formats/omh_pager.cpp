@@ -27,8 +27,7 @@ OmhPager::OmhPager(const omh::Header& header, std::shared_ptr<SortedCloud> cloud
       m_cloud(std::move(cloud)), m_hierarchy(hierarchy), m_stream(header.path),
       m_decoder(m_header, *m_cloud, hierarchy.mutableStoredSplats()),
       m_state(std::make_unique<std::atomic<std::uint8_t>[]>(header.totalNodes)),
-      m_wantedFrame(header.totalNodes, 0),
-      m_lastUsed(header.totalNodes, 0) {
+      m_wantedFrame(header.totalNodes, 0), m_lastUsed(header.totalNodes, 0) {
     std::uint64_t base = 0, first = 0;
     for (const omh::LevelEntry& level : header.levels) {
         m_levelBase.push_back(base);
@@ -119,8 +118,7 @@ void OmhPager::endFrame() {
     publishRequests(frame);
     {
         std::lock_guard lock(m_mutex);
-        m_residentList.insert(m_residentList.end(), m_newlyResident.begin(),
-                              m_newlyResident.end());
+        m_residentList.insert(m_residentList.end(), m_newlyResident.begin(), m_newlyResident.end());
         m_newlyResident.clear();
     }
     if (m_residentBytes.load(std::memory_order_relaxed) > m_budget) {
@@ -128,8 +126,9 @@ void OmhPager::endFrame() {
         const auto lastUsed = [&](const NodeRef& node) {
             return m_lastUsed[nodeId(node.level, node.index)];
         };
-        const auto unused = std::partition(m_residentList.begin(), m_residentList.end(),
-                                           [&](const NodeRef& node) { return lastUsed(node) >= frame; });
+        const auto unused =
+            std::partition(m_residentList.begin(), m_residentList.end(),
+                           [&](const NodeRef& node) { return lastUsed(node) >= frame; });
         std::sort(unused, m_residentList.end(),
                   [&](const NodeRef& a, const NodeRef& b) { return lastUsed(a) < lastUsed(b); });
         const auto target = static_cast<std::uint64_t>(static_cast<double>(m_budget) * kEvictTo);
@@ -171,7 +170,7 @@ void OmhPager::loaderLoop() {
         }
         std::uint8_t queued = Queued;
         if (m_state[nodeId(request.level, request.index)].compare_exchange_strong(queued,
-                                                                                 Loading)) {
+                                                                                  Loading)) {
             load(request.level, request.index);
         }
     }
@@ -184,8 +183,8 @@ void OmhPager::load(int level, std::uint32_t index) {
     const std::size_t count = node.pointCount;
     const omh::LevelEntry& entry = m_header.levels[static_cast<std::size_t>(level)];
     const std::uint64_t offset =
-        entry.payloadOffset + (begin - m_levelFirst[static_cast<std::size_t>(level)]) *
-                                  m_header.recordBytes;
+        entry.payloadOffset +
+        (begin - m_levelFirst[static_cast<std::size_t>(level)]) * m_header.recordBytes;
     m_pages.acquire(begin, begin + count);
     try {
         m_records.resize(count * m_header.recordBytes);
@@ -194,8 +193,8 @@ void OmhPager::load(int level, std::uint32_t index) {
         m_stream.readExact(m_records.data(), m_records.size(), section);
         const std::size_t bad = m_decoder.store(m_records.data(), count, begin, node.code, level);
         if (bad != count) {
-            throw m_decoder.misplaced(level, begin + bad - m_levelFirst[static_cast<std::size_t>(level)],
-                                      node.code);
+            throw m_decoder.misplaced(
+                level, begin + bad - m_levelFirst[static_cast<std::size_t>(level)], node.code);
         }
     } catch (const InputError& error) {
         m_pages.release(begin, begin + count);

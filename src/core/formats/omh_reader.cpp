@@ -183,8 +183,8 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     if ((attributeBits & ~omh::kKnownAttributeBits) != 0) {
         throw malformed(h::kAttributes, "unknown attribute bits");
     }
-    info.attributes =
-        AttributeSet::fromBits(attributeBits, loadRaw<std::uint16_t>(header.data() + h::kExtraBytes));
+    info.attributes = AttributeSet::fromBits(
+        attributeBits, loadRaw<std::uint16_t>(header.data() + h::kExtraBytes));
     if (!info.attributes.valid()) {
         throw malformed(h::kExtraBytes, "GPS time, NIR and extra bytes need the LAS attribute bit");
     }
@@ -331,7 +331,8 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
         throw error(InputErrorKind::MalformedValue, footerStart,
                     "in the footer: expected the footer magic 'OMHEND\\x00\\x00'");
     }
-    const auto storedFooterChecksum = loadRaw<std::uint64_t>(footer.data() + omh::footer::kChecksum);
+    const auto storedFooterChecksum =
+        loadRaw<std::uint64_t>(footer.data() + omh::footer::kChecksum);
     if (storedFooterChecksum != omh::smallChecksum(footer.data(), omh::footer::kChecksum)) {
         throw error(InputErrorKind::MalformedValue, footerStart + omh::footer::kChecksum,
                     "footer checksum mismatch: the footer is damaged");

@@ -12,8 +12,8 @@ namespace omicron {
 OmhRecordDecoder::OmhRecordDecoder(const omh::Header& header, SortedCloud& cloud,
                                    StoredSplats& splats)
     : m_header(header), m_layout(omh::RecordLayout::of(header.attributes, header.estimatedNormals)),
-      m_attributes(header.attributes), m_estimatedNormals(header.estimatedNormals),
-      m_cloud(cloud), m_splats(splats) {}
+      m_attributes(header.attributes), m_estimatedNormals(header.estimatedNormals), m_cloud(cloud),
+      m_splats(splats) {}
 
 std::size_t OmhRecordDecoder::store(const std::uint8_t* records, std::size_t count,
                                     std::size_t point, morton::Code nodeCode, int level) const {
@@ -53,8 +53,8 @@ std::size_t OmhRecordDecoder::store(const std::uint8_t* records, std::size_t cou
 
 InputError OmhRecordDecoder::misplaced(int level, std::uint64_t recordInLevel,
                                        morton::Code nodeCode) const {
-    const std::uint64_t byte =
-        m_header.levels[static_cast<std::size_t>(level)].payloadOffset + recordInLevel * m_layout.bytes;
+    const std::uint64_t byte = m_header.levels[static_cast<std::size_t>(level)].payloadOffset +
+                               recordInLevel * m_layout.bytes;
     char code[19];
     std::snprintf(code, sizeof(code), "0x%016llx", static_cast<unsigned long long>(nodeCode));
     return InputError(InputErrorKind::MalformedValue, m_header.path, InputLocation::byte(byte),

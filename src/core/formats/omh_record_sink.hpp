@@ -6,8 +6,8 @@
 
 #include "build/octree_node.hpp"
 #include "build/splat_estimator.hpp"
-#include "formats/oms_format.hpp"
 #include "formats/omh_format.hpp"
+#include "formats/oms_format.hpp"
 #include "io/atomic_file_writer.hpp"
 #include "points/sorted_cloud.hpp"
 

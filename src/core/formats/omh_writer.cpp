@@ -59,9 +59,8 @@ private:
         const SortedCloud& cloud = m_hierarchy.cloud();
         cloud.keepWithinBudget(); // what the previous batch read may go first
         const std::uint64_t maxCovered =
-            cloud.fileBacked()
-                ? cloud.residentBudget() / 8 / pointBytes(cloud.attributes())
-                : UINT64_MAX;
+            cloud.fileBacked() ? cloud.residentBudget() / 8 / pointBytes(cloud.attributes())
+                               : UINT64_MAX;
         const std::size_t coveredBegin = m_hierarchy.node(level, begin).coveredBegin;
         const auto coveredEnd = [&](std::size_t i) { // of nodes [begin, i]
             const OctreeNode& node = m_hierarchy.node(level, i);

@@ -76,8 +76,9 @@ bool isOmsFile(const std::string& path) {
     }
 }
 
-OmsReader::OmsReader(const std::string& path, PointStorage storage,
-                     std::uint64_t memoryBudgetBytes, const std::string& tempDir) : m_stream(path) {
+OmsReader::OmsReader(const std::string& path, PointStorage storage, std::uint64_t memoryBudgetBytes,
+                     const std::string& tempDir)
+    : m_stream(path) {
     namespace h = oms::header;
     const auto error = [&](InputErrorKind kind, std::uint64_t byte, const std::string& detail) {
         return InputError(kind, path, InputLocation::byte(byte), detail);
@@ -260,9 +261,9 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage,
     m_info.fileBytes = fileBytes;
     m_info.cube = CubeTransform{origin, edge};
     m_info.sourceOffset = sourceOffset;
-    m_cloud = makeSortedCloud(m_info.cube, sourceOffset, attributes,
-                              static_cast<std::size_t>(pointCount), storage, memoryBudgetBytes,
-                              tempDir);
+    m_cloud =
+        makeSortedCloud(m_info.cube, sourceOffset, attributes, static_cast<std::size_t>(pointCount),
+                        storage, memoryBudgetBytes, tempDir);
 }
 
 ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptions& options) {

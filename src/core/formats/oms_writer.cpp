@@ -31,7 +31,7 @@ std::array<std::uint8_t, oms::kHeaderBytes> encodeHeader(const CubeTransform& cu
     storeRaw(bytes.data() + h::kSortDepth, oms::kSortDepth);
     storeRaw(bytes.data() + h::kAttributes, attributes.bits());
     storeRaw(bytes.data() + h::kRecordBytes,
-          static_cast<std::uint16_t>(oms::RecordLayout::of(attributes).bytes));
+             static_cast<std::uint16_t>(oms::RecordLayout::of(attributes).bytes));
     storeRaw(bytes.data() + h::kExtraBytes, attributes.extraBytes());
     for (int axis = 0; axis < 3; ++axis) {
         storeRaw(bytes.data() + h::kCubeOrigin + 8 * axis, cube.origin[axis]);

@@ -58,16 +58,20 @@ struct LasFieldSpec {
     const char* type;
 };
 constexpr std::array<LasFieldSpec, 7> kLasFields{{{"return number", 1, "uint8"},
-                                                   {"number of returns", 1, "uint8"},
-                                                   {"classification", 1, "uint8"},
-                                                   {"scan angle", 2, "int16"},
-                                                   {"user data", 1, "uint8"},
-                                                   {"point source id", 2, "uint16"},
-                                                   {"gps-time", 8, "double"}}};
+                                                  {"number of returns", 1, "uint8"},
+                                                  {"classification", 1, "uint8"},
+                                                  {"scan angle", 2, "int16"},
+                                                  {"user data", 1, "uint8"},
+                                                  {"point source id", 2, "uint16"},
+                                                  {"gps-time", 8, "double"}}};
 
 std::array<double, 7> lasFieldValues(const LasFields& f) {
-    return {double(f.returnNumber()), double(f.numberOfReturns()), double(f.classification),
-            double(f.scanAngle),      double(f.userData),          double(f.pointSourceId),
+    return {double(f.returnNumber()),
+            double(f.numberOfReturns()),
+            double(f.classification),
+            double(f.scanAngle),
+            double(f.userData),
+            double(f.pointSourceId),
             f.gpsTime};
 }
 

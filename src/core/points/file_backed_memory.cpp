@@ -12,11 +12,10 @@ namespace omicron {
 namespace {
 
 [[noreturn]] void fail(const std::string& folder, std::size_t bytes, const char* what, int error) {
-    throw std::runtime_error(folder + ": cannot keep " + std::to_string(bytes >> 20) + " MiB (" +
-                             std::to_string(bytes) +
-                             " bytes) of sorted points beyond the memory budget there (" + what +
-                             ": " + std::strerror(error) +
-                             "); free space there or choose another folder with --temp-dir");
+    throw std::runtime_error(
+        folder + ": cannot keep " + std::to_string(bytes >> 20) + " MiB (" + std::to_string(bytes) +
+        " bytes) of sorted points beyond the memory budget there (" + what + ": " +
+        std::strerror(error) + "); free space there or choose another folder with --temp-dir");
 }
 
 } // namespace

@@ -19,8 +19,8 @@
 #include <cstdlib>
 #include <memory>
 #include <new>
-#include <string>
 #include <span>
+#include <string>
 #include <sys/mman.h>
 #include <type_traits>
 

@@ -36,8 +36,7 @@ SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffs
         throw std::invalid_argument("SortedCloud: only an exact node-order cloud is paged");
     }
     if (storage == PointStorage::Packed) {
-        m_packed =
-            std::make_unique<PackedPointStore>(capacity, attributes.has(Attribute::Color));
+        m_packed = std::make_unique<PackedPointStore>(capacity, attributes.has(Attribute::Color));
     }
 }
 
@@ -50,8 +49,7 @@ SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffs
       m_normals(attributes.has(Attribute::Normal) ? capacity : 0, backing),
       m_colors(attributes.has(Attribute::Color) ? capacity : 0, backing),
       m_intensities(attributes.has(Attribute::Intensity) ? capacity : 0, backing),
-      m_las(capacity * attributes.lasBytes(), backing),
-      m_blockCodes(blockCodeCount(capacity)) {
+      m_las(capacity * attributes.lasBytes(), backing), m_blockCodes(blockCodeCount(capacity)) {
     m_governor = std::make_unique<ResidentSetGovernor>(budgetBytes, [this] {
         m_positions.dropResident();
         m_normals.dropResident();
@@ -72,11 +70,10 @@ SortedCloud::StagedRange SortedCloud::stage(std::size_t end) {
                                  : std::span(array.data() + begin, count);
     };
     const std::size_t lasBytes = m_attributes.lasBytes();
-    StagedRange staged{inPlace(m_positions), inPlace(m_normals), inPlace(m_colors),
-                       inPlace(m_intensities),
-                       lasBytes == 0 ? std::span<std::uint8_t>()
-                                     : std::span(m_las.data() + begin * lasBytes,
-                                                 count * lasBytes)};
+    StagedRange staged{
+        inPlace(m_positions), inPlace(m_normals), inPlace(m_colors), inPlace(m_intensities),
+        lasBytes == 0 ? std::span<std::uint8_t>()
+                      : std::span(m_las.data() + begin * lasBytes, count * lasBytes)};
     if (m_packed) {
         m_stagedPositions.resize(count);
         staged.positions = m_stagedPositions;

@@ -24,11 +24,11 @@
 #include "points/block_codes.hpp"
 #include "points/cube_transform.hpp"
 #include "points/huge_page_buffer.hpp"
-#include "points/resident_set_governor.hpp"
 #include "points/morton.hpp"
 #include "points/packed_points.hpp"
 #include "points/point_batch.hpp"
 #include "points/position_views.hpp"
+#include "points/resident_set_governor.hpp"
 
 #include <atomic>
 #include <cassert>
@@ -125,7 +125,9 @@ public:
     }
     // What the LAS column's extra bytes are (the source's Extra Bytes descriptors, 192 bytes
     // each), for a LAS export; empty when unknown. Set by the producer before it publishes.
-    const std::vector<std::uint8_t>& lasExtraBytesDescriptors() const { return m_extraBytesDescriptors; }
+    const std::vector<std::uint8_t>& lasExtraBytesDescriptors() const {
+        return m_extraBytesDescriptors;
+    }
     void setLasExtraBytesDescriptors(std::vector<std::uint8_t> descriptors) {
         m_extraBytesDescriptors = std::move(descriptors);
     }
@@ -204,7 +206,7 @@ private:
     HugePageArray<std::uint8_t> m_las;
     std::vector<std::uint8_t> m_extraBytesDescriptors;
     std::vector<std::uint8_t> m_projectionRecords;
-    HugePageArray<morton::Code> m_blockCodes;    // CloudOrder::Morton only
+    HugePageArray<morton::Code> m_blockCodes;   // CloudOrder::Morton only
     std::unique_ptr<PackedPointStore> m_packed; // Packed storage only
     // Packed or file-backed: the range stage() handed out, for publish() to encode or write.
     std::vector<glm::vec3> m_stagedPositions;

@@ -70,8 +70,8 @@ void gatherColumn(std::uint8_t* out, const std::uint8_t* in, const std::uint32_t
 std::uint64_t IncrementalMortonSorter::inMemoryBytes(const CloudInfo& info) {
     // Input in arrival order + the sorted cloud's copy + bin index + code (in the sorted cloud
     // and as a key of the chunk being sorted) + chunk scratch.
-    const std::uint64_t perPoint = 2 * pointBytes(info.attributes) +
-                                   sizeof(morton::Code) + sizeof(std::uint32_t) + 1;
+    const std::uint64_t perPoint =
+        2 * pointBytes(info.attributes) + sizeof(morton::Code) + sizeof(std::uint32_t) + 1;
     return info.pointCount * perPoint;
 }
 
@@ -90,8 +90,8 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
     const bool spills = inMemoryBytes(info) > budget;
     if (spills) {
         // First: it checks the scratch folder and its free space.
-        const std::uint64_t runPoints =
-            std::max(kMinRunPoints, budget / 2 / RunSpiller::bytesPerBufferedPoint(info.attributes));
+        const std::uint64_t runPoints = std::max(
+            kMinRunPoints, budget / 2 / RunSpiller::bytesPerBufferedPoint(info.attributes));
         m_spiller = std::make_unique<RunSpiller>(
             m_options.tempDir, info.attributes,
             static_cast<std::size_t>(std::min<std::uint64_t>(runPoints, capacity)),
@@ -155,7 +155,9 @@ void IncrementalMortonSorter::add(const PointBatch& batch) {
     m_input.append(batch);
 }
 
-PreviewSample IncrementalMortonSorter::preview() const { return m_preview.sample(); }
+PreviewSample IncrementalMortonSorter::preview() const {
+    return m_preview.sample();
+}
 
 bool IncrementalMortonSorter::cancelled() const {
     return m_options.cancel != nullptr && m_options.cancel->load(std::memory_order_relaxed);
@@ -297,27 +299,27 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                    // Gather every attribute into its sorted place.
                    const SortedCloud::StagedRange out = cloud.stage(chunkBegin[c + 1]);
                    const std::size_t lasBytes = m_input.attributes.lasBytes();
-                   tbb::parallel_for(
-                       tbb::blocked_range<std::size_t>(0, size, 8192),
-                       [&](const tbb::blocked_range<std::size_t>& range) {
-                           for (std::size_t i = range.begin(); i < range.end(); ++i) {
-                               const std::uint32_t from = indices[i];
-                               out.positions[i] = m_input.positions[from];
-                               if (!m_input.normals.empty()) {
-                                   out.normals[i] = m_input.normals[from];
-                               }
-                               if (!m_input.colors.empty()) {
-                                   out.colors[i] = m_input.colors[from];
-                               }
-                               if (!m_input.intensities.empty()) {
-                                   out.intensities[i] = m_input.intensities[from];
-                               }
-                           }
-                           if (lasBytes != 0) {
-                               gatherColumn(out.las.data(), m_input.las.data(), indices.data(),
-                                            range.begin(), range.end(), lasBytes);
-                           }
-                       });
+                   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, size, 8192),
+                                     [&](const tbb::blocked_range<std::size_t>& range) {
+                                         for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                                             const std::uint32_t from = indices[i];
+                                             out.positions[i] = m_input.positions[from];
+                                             if (!m_input.normals.empty()) {
+                                                 out.normals[i] = m_input.normals[from];
+                                             }
+                                             if (!m_input.colors.empty()) {
+                                                 out.colors[i] = m_input.colors[from];
+                                             }
+                                             if (!m_input.intensities.empty()) {
+                                                 out.intensities[i] = m_input.intensities[from];
+                                             }
+                                         }
+                                         if (lasBytes != 0) {
+                                             gatherColumn(out.las.data(), m_input.las.data(),
+                                                          indices.data(), range.begin(),
+                                                          range.end(), lasBytes);
+                                         }
+                                     });
                    for (const std::size_t block : blocksDone[c]) {
                        releaseInputBlock(block);
                    }

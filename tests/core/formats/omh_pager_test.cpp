@@ -88,8 +88,8 @@ void expectFrontPointsEqual(const Front& front, const Hierarchy& paged, const Hi
             const std::size_t lasBytes = a.attributes().lasBytes();
             if (lasBytes != 0) { // no LAS column: no record to compare (and memcmp of null)
                 ASSERT_EQ(std::memcmp(a.lasRecord(i), b.lasRecord(i), lasBytes), 0)
-                    << "the LAS fields of level " << level << " node " << entry.index
-                    << " point " << p;
+                    << "the LAS fields of level " << level << " node " << entry.index << " point "
+                    << p;
             }
         }
         paged.nodeSplats(node, pagedSplats, scratch);

@@ -138,8 +138,7 @@ TEST(CopcHierarchy, ANodeThatIsNoChunkIsAClearError) {
         FAIL() << "a hierarchy node pointing into a chunk was accepted";
     } catch (const InputError& error) {
         EXPECT_EQ(error.kind(), InputErrorKind::CorruptData);
-        EXPECT_NE(std::string(error.what()).find("not a chunk"), std::string::npos)
-            << error.what();
+        EXPECT_NE(std::string(error.what()).find("not a chunk"), std::string::npos) << error.what();
     }
 }
 

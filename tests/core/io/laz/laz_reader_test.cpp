@@ -22,10 +22,9 @@ TEST(LazReader, LayeredFileDescribesItsCompression) {
     EXPECT_EQ(info.format, CloudFormat::Laz);
     EXPECT_STREQ(toString(info.format), "LAZ");
     EXPECT_EQ(info.pointCount, 697721u);
-    EXPECT_EQ(info.attributes,
-              (AttributeSet(Attribute::Intensity) | Attribute::Color | Attribute::Las |
-               Attribute::GpsTime | Attribute::Nir)
-                  .setExtraBytes(3));
+    EXPECT_EQ(info.attributes, (AttributeSet(Attribute::Intensity) | Attribute::Color |
+                                Attribute::Las | Attribute::GpsTime | Attribute::Nir)
+                                   .setExtraBytes(3));
     EXPECT_TRUE(info.boundsFromHeader);
     expectMentions(info.formatDetail, "LAS 1.4, point format 8, 41-byte records (3 extra bytes)");
     expectMentions(info.formatDetail, "layered chunks (POINT14 v3, RGBNIR14 v3, BYTE14 v3)");

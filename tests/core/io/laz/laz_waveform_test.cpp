@@ -184,7 +184,8 @@ TEST_P(PointwiseWavePackets, DecodeByteForByte) {
         ADD_FAILURE() << "a truncated wave packet chunk was read";
     } catch (const InputError& error) {
         EXPECT_EQ(error.kind(), InputErrorKind::CorruptData) << error.what();
-        EXPECT_NE(std::string(error.what()).find("LAZ chunk 2 of 3 (points 200 to 249"), std::string::npos)
+        EXPECT_NE(std::string(error.what()).find("LAZ chunk 2 of 3 (points 200 to 249"),
+                  std::string::npos)
             << error.what();
     }
     // The fuzz target's seeds in tests/data are these files.
