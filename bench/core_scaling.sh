@@ -34,7 +34,7 @@ source bench/measure.sh
 
 input="$work/input.las"
 "$cli" tile "$cloud" "$input" --copies "$copies" > /dev/null
-points=$("$cli" info "$input" | awk '/^points:/ { print $2 }')
+points=$(points_in "$input")
 echo "bench=core_scaling step=input cloud=$(basename "$cloud") copies=$copies points=$points"
 
 declare -A walls
@@ -49,7 +49,6 @@ for run in $(seq 1 "$runs"); do
   done
 done
 
-median() { tr ' ' '\n' | grep -v '^$' | sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 one=$(echo "${walls[1]}" | median)
 two=$(echo "${walls[2]}" | median)
 awk -v p="$points" -v o="$one" -v t="$two" 'BEGIN {

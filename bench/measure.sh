@@ -1,5 +1,5 @@
-# Shared by the benchmark scripts (source it; needs $work, a scratch folder): runs a command
-# under /usr/bin/time -v with its output in $work/out.txt and $work/err.txt, and prints
+# Shared by the benchmark scripts (source it). measure: runs a command under /usr/bin/time -v
+# with its output in $work/out.txt and $work/err.txt ($work: a scratch folder), and prints
 # "wall_s user_s sys_s peak_kib".
 # shellcheck shell=bash
 measure() {
@@ -8,4 +8,15 @@ measure() {
               /User time/ { user = $2 } /System time/ { sys = $2 }
               /Maximum resident set size/ { rss = $2 }
               END { printf "%.2f %.2f %.2f %d\n", wall, user, sys, rss }' "$work/time.txt"
+}
+
+# The median of the numbers on standard input (separated by spaces or lines).
+median() {
+  tr ' ' '\n' | grep -v '^$' | sort -g |
+    awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
+}
+
+# The number of points `omicron-cli info` reports for a cloud file ($cli: the omicron-cli binary).
+points_in() {
+  "$cli" info "$1" | awk '/^points:/ { print $2 }'
 }

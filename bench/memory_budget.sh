@@ -23,7 +23,7 @@ trap 'rm -rf "$work"' EXIT
 
 source bench/measure.sh
 
-points=$("$cli" info "$input" | awk '/^points:/ { print $2 }')
+points=$(points_in "$input")
 read -r wall user sys rss < <(measure sh -c "cat '$input' > '$work/copy'")
 rm -f "$work/copy"
 echo "bench=memory_budget command=copy points=$points bytes=$(stat -c %s "$input") wall_s=$wall user_s=$user sys_s=$sys peak_rss_mib=$((rss / 1024))"

@@ -32,7 +32,7 @@ source bench/measure.sh
 written_bytes() { awk -F': ' '/File system outputs/ { printf "%.0f\n", $2 * 512 }' "$work/time.txt"; }
 
 read -r wall _ _ rss < <(measure "$cli" tile "$source_cloud" "$work/big.ply" --copies "$copies")
-points=$("$cli" info "$work/big.ply" | awk '/^points:/ { print $2 }')
+points=$(points_in "$work/big.ply")
 bytes=$(stat -c %s "$work/big.ply")
 echo "bench=out_of_core step=tile copies=$copies points=$points bytes=$bytes wall_s=$wall peak_rss_mib=$((rss / 1024))"
 read -r wall _ _ rss < <(measure sh -c "cat '$work/big.ply' > /dev/null")

@@ -70,35 +70,42 @@ std::uint64_t readAll(const std::string& path, const omicron::OpenOptions& optio
     return points;
 }
 
+// One bench=read line: `seconds` to deliver `points` from a file of `bytes`, against
+// `rawSeconds` to read those bytes.
+void printRead(const std::string& label, const char* phase, std::uint64_t points,
+               std::uint64_t bytes, double seconds, double rawSeconds) {
+    std::printf("bench=read reader=%s phase=%s points=%llu bytes=%llu bytes_per_point=%.1f "
+                "ms=%.1f mpoints_per_s=%.2f mb_per_s=%.1f raw_mb_per_s=%.1f ratio_vs_raw=%.3f\n",
+                label.c_str(), phase, static_cast<unsigned long long>(points),
+                static_cast<unsigned long long>(bytes), double(bytes) / double(points),
+                seconds * 1e3, points / seconds / 1e6, bytes / seconds / 1e6,
+                bytes / rawSeconds / 1e6, rawSeconds / seconds);
+    std::fflush(stdout);
+}
+
+// The best of `runs` raw reads of `path`, the page cache warmed first.
+double rawReadSeconds(const std::string& path, int runs) {
+    rawRead(path);
+    return bestSeconds(runs, [&] { rawRead(path); });
+}
+
 void measure(const std::string& label, const std::string& path, int runs) {
     const std::uint64_t bytes = std::filesystem::file_size(path);
-    rawRead(path); // warm the page cache
-    const double rawS = bestSeconds(runs, [&] { rawRead(path); });
-    const double rawMbPerS = bytes / rawS / 1e6;
-
+    const double rawS = rawReadSeconds(path, runs);
     std::uint64_t points = 0;
     const double fullS = bestSeconds(runs, [&] { points = readAll(path, {}); });
     const omicron::Bounds bounds = omicron::openPointCloud(path)->info().sourceBounds;
     omicron::OpenOptions known;
     known.knownBounds = bounds;
     const double parseS = bestSeconds(runs, [&] { readAll(path, known); });
-
-    for (const auto& [phase, s] : {std::pair{"open_and_read", fullS}, {"parse", parseS}}) {
-        std::printf("bench=read reader=%s phase=%s points=%llu bytes=%llu bytes_per_point=%.1f "
-                    "ms=%.1f mpoints_per_s=%.2f mb_per_s=%.1f raw_mb_per_s=%.1f "
-                    "ratio_vs_raw=%.3f\n",
-                    label.c_str(), phase, static_cast<unsigned long long>(points),
-                    static_cast<unsigned long long>(bytes), double(bytes) / double(points), s * 1e3,
-                    points / s / 1e6, bytes / s / 1e6, rawMbPerS, rawS / s);
-    }
-    std::fflush(stdout);
+    printRead(label, "open_and_read", points, bytes, fullS, rawS);
+    printRead(label, "parse", points, bytes, parseS, rawS);
 }
 
 // A .oms into its sorted cloud, as `build IN.oms` reads it (without the builder).
 void measureOms(const std::string& path, int runs) {
     const std::uint64_t bytes = std::filesystem::file_size(path);
-    rawRead(path); // warm the page cache
-    const double rawS = bestSeconds(runs, [&] { rawRead(path); });
+    const double rawS = rawReadSeconds(path, runs);
     std::uint64_t points = 0;
     const double parseS = bestSeconds(runs, [&] {
         omicron::OmsReader reader(path);
@@ -107,12 +114,7 @@ void measureOms(const std::string& path, int runs) {
             points += end - begin;
         });
     });
-    std::printf("bench=read reader=oms phase=parse points=%llu bytes=%llu bytes_per_point=%.1f "
-                "ms=%.1f mpoints_per_s=%.2f mb_per_s=%.1f raw_mb_per_s=%.1f ratio_vs_raw=%.3f\n",
-                static_cast<unsigned long long>(points), static_cast<unsigned long long>(bytes),
-                double(bytes) / double(points), parseS * 1e3, points / parseS / 1e6,
-                bytes / parseS / 1e6, bytes / rawS / 1e6, rawS / parseS);
-    std::fflush(stdout);
+    printRead("oms", "parse", points, bytes, parseS, rawS);
 }
 
 // Sorts `input` into `oms` (pipeline 1; the cloud is written once sorted).

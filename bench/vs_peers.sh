@@ -37,7 +37,7 @@ source bench/measure.sh
 
 input="$work/input.las"
 "$cli" tile "$cloud" "$input" --copies "$copies" > /dev/null
-points=$("$cli" info "$input" | awk '/^points:/ { print $2 }')
+points=$(points_in "$input")
 echo "bench=vs_peers step=input cloud=$(basename "$cloud") copies=$copies points=$points bytes=$(stat -c %s "$input")"
 
 declare -A walls rsss
@@ -57,7 +57,6 @@ for run in $(seq 1 "$runs"); do
   done
 done
 
-median() { tr ' ' '\n' | grep -v '^$' | sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 ours=$(echo "${walls[omicron]}" | median)
 theirs=$(echo "${walls[potree_random]}" | median)
 our_rss=$(echo "${rsss[omicron]}" | median)

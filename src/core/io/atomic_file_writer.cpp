@@ -152,21 +152,22 @@ void AtomicFileWriter::extendTo(std::uint64_t size) {
     const auto from = static_cast<off_t>(m_onFile);
     const auto count = static_cast<off_t>(size - m_onFile);
     if (count > 0) {
-        const std::optional<std::uint64_t> tmpfsFree = tmpfsFreeBytes(m_fd);
-        if (tmpfsFree && *tmpfsFree < static_cast<std::uint64_t>(count)) {
-            fail("no room for the " + std::to_string(size) + " bytes of the file", ENOSPC);
-        }
+        const std::string noRoom = "no room for the " + std::to_string(size) + " bytes of the file";
         // fallocate rather than posix_fallocate: where the file system cannot reserve, the
-        // region is left sparse (ftruncate) instead of being written with zeros first. On a
-        // tmpfs the room was checked above and the region is left sparse on purpose.
-        if (tmpfsFree || ::fallocate(m_fd, 0, from, count) != 0) {
-            const int error = tmpfsFree ? 0 : errno;
-            if (error == ENOSPC || error == EDQUOT) {
-                fail("no room for the " + std::to_string(size) + " bytes of the file", error);
+        // region is left sparse (ftruncate) instead of being written with zeros first. A tmpfs
+        // only has its room checked, and the region is left sparse on purpose.
+        bool reserved = false;
+        if (const std::optional<std::uint64_t> tmpfsFree = tmpfsFreeBytes(m_fd)) {
+            if (*tmpfsFree < static_cast<std::uint64_t>(count)) {
+                fail(noRoom, ENOSPC);
             }
-            if (::ftruncate(m_fd, static_cast<off_t>(size)) != 0) {
-                fail("cannot extend the file to " + std::to_string(size) + " bytes", errno);
-            }
+        } else if (::fallocate(m_fd, 0, from, count) == 0) {
+            reserved = true;
+        } else if (errno == ENOSPC || errno == EDQUOT) {
+            fail(noRoom, errno);
+        }
+        if (!reserved && ::ftruncate(m_fd, static_cast<off_t>(size)) != 0) {
+            fail("cannot extend the file to " + std::to_string(size) + " bytes", errno);
         }
     }
     if (::lseek(m_fd, static_cast<off_t>(size), SEEK_SET) < 0) {

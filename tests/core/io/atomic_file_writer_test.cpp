@@ -53,15 +53,17 @@ std::vector<char> contentsOf(const std::string& path) {
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-// Writes a header, extends the file, fills the extended region back to front with writeAt
-// and appends a footer: the file must hold exactly that, whatever extendTo did underneath.
-void writeOutOfOrder(const std::string& path, std::vector<char>& expected) {
+// Writes a header to `folder`/out.bin, extends the file, fills the extended region back to
+// front with writeAt and appends a footer: the file must hold exactly that, whatever extendTo
+// did underneath, and be the folder's only entry.
+void expectOutOfOrderFillIsTheFile(const std::filesystem::path& folder) {
+    const std::string path = (folder / "out.bin").string();
     constexpr std::size_t kRegion = 3 << 20;
     AtomicFileWriter file(path);
     const std::string header = "header";
     file.write(header);
     file.extendTo(header.size() + kRegion);
-    expected.assign(header.begin(), header.end());
+    std::vector<char> expected(header.begin(), header.end());
     expected.resize(header.size() + kRegion);
     constexpr std::size_t kPiece = 1 << 20;
     for (std::size_t piece = kRegion / kPiece; piece-- > 0;) {
@@ -69,19 +71,17 @@ void writeOutOfOrder(const std::string& path, std::vector<char>& expected) {
         file.writeAt(header.size() + piece * kPiece, bytes.data(), bytes.size());
         std::copy(bytes.begin(), bytes.end(), expected.begin() + header.size() + piece * kPiece);
     }
-    file.write("footer");
     const std::string footer = "footer";
+    file.write(footer);
     expected.insert(expected.end(), footer.begin(), footer.end());
     file.commit();
+    EXPECT_EQ(contentsOf(path), expected);
+    EXPECT_EQ(entriesIn(folder), 1u) << "the temporary file was left behind";
 }
 
 TEST(AtomicFileWriterExtend, TheExtendedRegionFilledOutOfOrderIsTheFileOnADisk) {
     test::TempDir dir;
-    const std::string path = dir.file("out.bin");
-    std::vector<char> expected;
-    writeOutOfOrder(path, expected);
-    EXPECT_EQ(contentsOf(path), expected);
-    EXPECT_EQ(entriesIn(dir.path()), 1u) << "the temporary file was left behind";
+    expectOutOfOrderFillIsTheFile(dir.path());
 }
 
 TEST(AtomicFileWriterExtend, TheExtendedRegionFilledOutOfOrderIsTheFileOnATmpfs) {
@@ -89,11 +89,7 @@ TEST(AtomicFileWriterExtend, TheExtendedRegionFilledOutOfOrderIsTheFileOnATmpfs)
     if (dir.path().empty()) {
         GTEST_SKIP() << "/dev/shm is not a tmpfs here";
     }
-    const std::string path = (dir.path() / "out.bin").string();
-    std::vector<char> expected;
-    writeOutOfOrder(path, expected);
-    EXPECT_EQ(contentsOf(path), expected);
-    EXPECT_EQ(entriesIn(dir.path()), 1u) << "the temporary file was left behind";
+    expectOutOfOrderFillIsTheFile(dir.path());
 }
 
 // On a tmpfs the region is not reserved (its pages would be zeroed on the spot): the file
