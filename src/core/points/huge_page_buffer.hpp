@@ -4,14 +4,17 @@
 // first touch and scans that stride through memory miss the TLB (measured: a skip-ahead scan
 // of 4.8M sorted positions runs 1.35x faster on huge pages). An array aligned to 2 MiB and
 // advised MADV_HUGEPAGE takes one fault and one TLB entry per 2 MiB instead. Where huge
-// pages are off ("never") this is an ordinary aligned allocation. The elements are left
-// uninitialised: the owners write before they publish.
+// pages are off ("never"), or cost more than they save (a hypervisor that takes free memory
+// back: points/huge_page_policy.hpp), this is an ordinary aligned allocation on small pages.
+// The elements are left uninitialised: the owners write before they publish.
 //
 // A cloud paged in on demand (a large .omh) wants the opposite: address space for every point,
 // memory only for the nodes loaded, given back when a node is evicted. Its arrays ask for
 // small pages (PageSize::Small): a huge page would turn the first write of a 100-point node
 // into 2 MiB resident, and releasing part of one splits it (points/resident_pages.hpp).
 #pragma once
+
+#include "points/huge_page_policy.hpp"
 
 #include <algorithm>
 #include <cstddef>
@@ -74,9 +77,12 @@ inline void adviseWholePages(const void* memory, std::size_t bytes, std::size_t 
 
 // Advises huge pages for the whole 2 MiB pages inside [memory, memory + bytes): for a large
 // buffer allocated elsewhere (a reserved std::vector) and not touched yet, so its first touch
-// takes a fault per 2 MiB instead of per 4 KiB. Advice only: a refusal changes nothing.
+// takes a fault per 2 MiB instead of per 4 KiB. Advice only: a refusal changes nothing, and
+// none is given where huge pages do not pay off.
 inline void adviseHugePages(const void* memory, std::size_t bytes) {
-    adviseWholePages(memory, bytes, kHugePageBytes, MADV_HUGEPAGE);
+    if (hugePagesPayOff()) {
+        adviseWholePages(memory, bytes, kHugePageBytes, MADV_HUGEPAGE);
+    }
 }
 
 // Gives back the whole small pages inside [memory, memory + bytes) of an anonymous buffer whose
@@ -112,7 +118,8 @@ public:
             throw std::bad_alloc();
         }
         // Advice only: a refusal leaves the kernel's default.
-        madvise(memory, bytes, pages == PageSize::Huge ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
+        const bool huge = pages == PageSize::Huge && hugePagesPayOff();
+        madvise(memory, bytes, huge ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
         m_data.reset(static_cast<T*>(memory));
     }
 
