@@ -61,6 +61,20 @@ SortedCloud::SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffs
 
 SortedCloud::~SortedCloud() = default;
 
+SortedCloud::InPlaceArrays SortedCloud::inPlaceArrays() {
+    if (fileBacked()) {
+        return {};
+    }
+    const auto bytes = [](auto& array) {
+        return array.size() == 0
+                   ? std::span<std::byte>()
+                   : std::span(reinterpret_cast<std::byte*>(array.data()), array.bytesAllocated());
+    };
+    // The packed store has no position and colour arrays: it stages and encodes them.
+    return {bytes(m_positions), bytes(m_normals), bytes(m_colors), bytes(m_intensities),
+            bytes(m_las)};
+}
+
 SortedCloud::StagedRange SortedCloud::stage(std::size_t end) {
     const std::size_t begin = m_sortedEnd.load(std::memory_order_relaxed);
     assert(begin <= end && end <= m_capacity);

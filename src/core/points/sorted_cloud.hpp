@@ -158,6 +158,18 @@ public:
     };
     StagedRange stage(std::size_t end);
 
+    // The whole arrays stage() hands out in place (in memory; positions and colours only in
+    // the exact store), for a producer that backs their untouched pages itself
+    // (points/page_recycler.hpp); empty spans for the others.
+    struct InPlaceArrays {
+        std::span<std::byte> positions;
+        std::span<std::byte> normals;
+        std::span<std::byte> colors;
+        std::span<std::byte> intensities;
+        std::span<std::byte> las;
+    };
+    InPlaceArrays inPlaceArrays();
+
     void publish(std::size_t newSortedEnd);
     void markComplete();
 

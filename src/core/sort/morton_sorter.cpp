@@ -3,6 +3,7 @@
 #include "io/overlapped_batch_consumer.hpp"
 #include "memory_budget.hpp"
 #include "points/huge_page_buffer.hpp"
+#include "points/huge_page_policy.hpp"
 #include "sort/budgeted_cloud.hpp"
 #include "sort/radix_sort.hpp"
 #include "sort/run_merger.hpp"
@@ -120,6 +121,16 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
     advise(m_input.colors);
     advise(m_input.intensities);
     advise(m_input.las);
+    if (m_options.recyclePages.value_or(!hugePagesPayOff())) {
+        const SortedCloud::InPlaceArrays sorted = m_cloud->inPlaceArrays();
+        const std::array<std::span<std::byte>, 5> recipients{
+            sorted.positions, sorted.normals, sorted.colors, sorted.intensities, sorted.las};
+        for (std::size_t column = 0; column < recipients.size(); ++column) {
+            if (!recipients[column].empty()) {
+                m_recyclers[column] = std::make_unique<PageRecycler>(recipients[column]);
+            }
+        }
+    }
 }
 
 void IncrementalMortonSorter::add(const PointBatch& batch) {
@@ -206,19 +217,34 @@ void IncrementalMortonSorter::releaseInputBlock(std::size_t block) {
     const std::size_t begin = block << kReleaseBlockBits;
     const std::size_t count =
         std::min(m_input.size(), begin + (std::size_t{1} << kReleaseBlockBits)) - begin;
-    const auto release = [&](const auto& array) {
-        if (!array.empty()) {
-            constexpr std::size_t bytes = sizeof(array[0]);
-            releasePages(array.data() + begin, count * bytes);
+    // Into the sorted cloud's next pages where a recycler takes them, else to the kernel.
+    const auto release = [&](std::size_t column, const auto& array, std::size_t pointBytes) {
+        if (array.empty()) {
+            return;
+        }
+        const auto* memory = reinterpret_cast<const std::uint8_t*>(array.data());
+        if (m_recyclers[column]) {
+            m_recyclers[column]->donate(memory + begin * pointBytes, count * pointBytes);
+        } else {
+            releasePages(memory + begin * pointBytes, count * pointBytes);
         }
     };
-    release(m_input.positions);
-    release(m_input.normals);
-    release(m_input.colors);
-    release(m_input.intensities);
-    const std::size_t lasBytes = m_input.attributes.lasBytes();
-    if (lasBytes != 0) {
-        releasePages(m_input.las.data() + begin * lasBytes, count * lasBytes);
+    release(0, m_input.positions, sizeof(glm::vec3));
+    release(1, m_input.normals, sizeof(glm::vec3));
+    release(2, m_input.colors, sizeof(glm::u8vec3));
+    release(3, m_input.intensities, sizeof(std::uint16_t));
+    release(4, m_input.las, m_input.attributes.lasBytes());
+}
+
+void IncrementalMortonSorter::prepareRecycledPages(const SortedCloud::StagedRange& out) {
+    const std::array<const void*, 5> ends{
+        out.positions.data() + out.positions.size(), out.normals.data() + out.normals.size(),
+        out.colors.data() + out.colors.size(), out.intensities.data() + out.intensities.size(),
+        out.las.data() + out.las.size()};
+    for (std::size_t column = 0; column < ends.size(); ++column) {
+        if (m_recyclers[column]) {
+            m_recyclers[column]->prepare(ends[column]);
+        }
     }
 }
 
@@ -298,6 +324,7 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                    malloc_trim(0);
                    // Gather every attribute into its sorted place.
                    const SortedCloud::StagedRange out = cloud.stage(chunkBegin[c + 1]);
+                   prepareRecycledPages(out);
                    const std::size_t lasBytes = m_input.attributes.lasBytes();
                    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, size, 8192),
                                      [&](const tbb::blocked_range<std::size_t>& range) {
@@ -342,6 +369,12 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                        }
                        ++chunksDone;
                    }));
+    for (std::unique_ptr<PageRecycler>& recycler : m_recyclers) {
+        if (recycler) {
+            m_pagesRecycled += recycler->pagesMoved();
+            recycler.reset(); // gives back what the cloud did not need
+        }
+    }
     if (!cancelled() && static_cast<std::size_t>(chunksDone) == chunks) {
         cloud.markComplete();
     }

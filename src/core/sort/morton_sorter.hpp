@@ -16,6 +16,7 @@
 #pragma once
 
 #include "io/point_reader.hpp"
+#include "points/page_recycler.hpp"
 #include "points/sorted_cloud.hpp"
 #include "sort/preview_sampler.hpp"
 #include "sort/run_spiller.hpp"
@@ -26,6 +27,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 namespace omicron {
@@ -47,6 +49,10 @@ struct SortOptions {
     // needs more is sorted in runs on disk, under `tempDir` (empty: $TMPDIR or /tmp).
     std::uint64_t memoryBudgetBytes = 0;
     std::string tempDir = {};
+    // An in-memory sort moves the input's pages into the sorted cloud as it gives them back
+    // (points/page_recycler.hpp) rather than let the cloud fault in fresh ones; default: where
+    // huge pages do not pay off (the cloud is on small pages then). Tests force either way.
+    std::optional<bool> recyclePages = std::nullopt;
 };
 
 // Receives [begin, end) of `cloud`, already published: every code in it is >= every code of
@@ -94,6 +100,9 @@ public:
     // whatever the cloud's size (how `omicron-cli sort` writes a .oms). Call once.
     void emitSortedBatches(const SortedBatchConsumer& consumer);
 
+    // Pages of the input moved into the sorted cloud (PageRecycler) by sortAndEmit().
+    std::size_t pagesRecycled() const { return m_pagesRecycled; }
+
     // Seconds from the start of sortAndEmit() to the first consumer call (-1 before it).
     double firstRangeSeconds() const { return m_firstRangeSeconds; }
 
@@ -126,6 +135,8 @@ private:
     std::vector<std::vector<std::size_t>>
     blocksDoneAfterChunk(const std::vector<std::size_t>& boundaries) const;
     void releaseInputBlock(std::size_t block);
+    // Backs the untouched pages of the range about to be gathered with given-back input.
+    void prepareRecycledPages(const SortedCloud::StagedRange& out);
     int mergeAndEmit(const SortedRangeConsumer& consumer);
     bool cancelled() const;
 
@@ -135,6 +146,10 @@ private:
 
     // Input in arrival order (attributes are gathered from here into the sorted cloud).
     PointBatch m_input;
+    // Per column (positions, normals, colours, intensities, LAS): where the input's pages go
+    // when given back; null: back to the kernel.
+    std::array<std::unique_ptr<PageRecycler>, 5> m_recyclers;
+    std::size_t m_pagesRecycled = 0;
     std::vector<Bin> m_bins;
     std::vector<std::uint16_t> m_blockLastBin;
     std::vector<morton::Code> m_batchCodes; // scratch for add()

@@ -1,0 +1,118 @@
+// PageRecycler: given-back pages back the recipient's next untouched pages, with their bytes;
+// the donor reads zero afterwards; what is not used goes back to the kernel.
+#include "points/page_recycler.hpp"
+
+#include <cstdlib>
+#include <cstring>
+#include <gtest/gtest.h>
+#include <memory>
+#include <sys/mman.h>
+
+namespace omicron {
+namespace {
+
+constexpr std::size_t kPage = 4096;
+
+// A page-aligned anonymous mapping of `pages` pages, unmapped at the end.
+struct Mapping {
+    explicit Mapping(std::size_t pages) : bytes(pages * kPage) {
+        void* memory =
+            mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        EXPECT_NE(memory, MAP_FAILED);
+        data = static_cast<std::byte*>(memory);
+    }
+    ~Mapping() { munmap(data, bytes); }
+    std::uint8_t at(std::size_t offset) const {
+        return std::to_integer<std::uint8_t>(data[offset]);
+    }
+    std::byte* data;
+    std::size_t bytes;
+};
+
+TEST(PageRecycler, DonatedPagesBackTheRecipientsNextPages) {
+    Mapping donor(8);
+    Mapping recipient(16);
+    for (std::size_t page = 0; page < 8; ++page) {
+        std::memset(donor.data + page * kPage, static_cast<int>(page + 1), kPage);
+    }
+    PageRecycler recycler({recipient.data, recipient.bytes});
+    // Pages 2-4 of the donor; the partial pages around them stay with it.
+    recycler.donate(donor.data + 2 * kPage - 100, 3 * kPage + 200);
+    recycler.prepare(recipient.data + 2 * kPage + 1); // pages 0-2 are about to be written
+    EXPECT_EQ(recycler.pagesMoved(), 3u);
+    // The recipient's pages are the donor's, bytes and all (the writer overwrites them).
+    EXPECT_EQ(recipient.at(0), 3);
+    EXPECT_EQ(recipient.at(kPage + 7), 4);
+    EXPECT_EQ(recipient.at(3 * kPage - 1), 5);
+    EXPECT_EQ(recipient.at(3 * kPage), 0); // not prepared: untouched
+    // The donor's moved pages read as zero; the others kept their bytes.
+    EXPECT_EQ(donor.at(2 * kPage), 0);
+    EXPECT_EQ(donor.at(5 * kPage - 1), 0);
+    EXPECT_EQ(donor.at(2 * kPage - 1), 2);
+    EXPECT_EQ(donor.at(5 * kPage), 6);
+}
+
+TEST(PageRecycler, APageAlreadyPreparedIsNeverReplaced) {
+    Mapping donor(8);
+    Mapping recipient(16);
+    std::memset(donor.data, 0x5a, donor.bytes);
+    PageRecycler recycler({recipient.data, recipient.bytes});
+    recycler.prepare(recipient.data + 10); // nothing to move: page 0 faults in
+    recipient.data[0] = std::byte{0x11};
+    recycler.donate(donor.data, 2 * kPage);
+    recycler.prepare(recipient.data + kPage + 1); // page 0 stays, page 1 is the donor's
+    EXPECT_EQ(recipient.at(0), 0x11);
+    EXPECT_EQ(recipient.at(kPage), 0x5a);
+    EXPECT_EQ(recycler.pagesMoved(), 1u);
+    // The donation's second page waits for the next prepare, and adjacent donations join:
+    // pages 2 and 3 come in one move.
+    recycler.donate(donor.data + 2 * kPage, 2 * kPage);
+    recycler.prepare(recipient.data + 4 * kPage);
+    EXPECT_EQ(recycler.pagesMoved(), 3u);
+    EXPECT_EQ(recycler.moves(), 2u);
+    EXPECT_EQ(recipient.at(4 * kPage - 1), 0x5a);
+}
+
+TEST(PageRecycler, WhatNoRecipientPageNeedsGoesBackToTheKernel) {
+    Mapping donor(8);
+    Mapping recipient(2);
+    std::memset(donor.data, 0x77, donor.bytes);
+    {
+        PageRecycler recycler({recipient.data, recipient.bytes});
+        recycler.donate(donor.data, 8 * kPage);
+        recycler.prepare(recipient.data + 100 * kPage); // clamped to the recipient's 2 pages
+        EXPECT_EQ(recycler.pagesMoved(), 2u);
+        EXPECT_EQ(donor.at(3 * kPage), 0x77); // still donated, not yet given back
+    }
+    // Nothing of the donor is resident any more (checked before reading maps zero pages in).
+    unsigned char resident[8];
+    ASSERT_EQ(mincore(donor.data, donor.bytes, resident), 0);
+    for (std::size_t page = 0; page < 8; ++page) {
+        EXPECT_EQ(resident[page] & 1, 0) << "page " << page << " still resident";
+    }
+    for (std::size_t page = 0; page < 8; ++page) {
+        EXPECT_EQ(donor.at(page * kPage), 0) << page;
+    }
+}
+
+TEST(PageRecycler, MovesStopAtTheMappingLimitAndPagesGoBack) {
+    // Every other page donated: each donation is a move (and a mapping) of its own.
+    const std::size_t donations = PageRecycler::kMaxMoves + 10;
+    Mapping donor(2 * donations);
+    Mapping recipient(donations);
+    std::memset(donor.data, 0x33, donor.bytes);
+    PageRecycler recycler({recipient.data, recipient.bytes});
+    for (std::size_t i = 0; i < donations; ++i) {
+        recycler.donate(donor.data + 2 * i * kPage, kPage);
+    }
+    recycler.prepare(recipient.data + recipient.bytes);
+    EXPECT_EQ(recycler.moves(), PageRecycler::kMaxMoves);
+    EXPECT_EQ(recipient.at((PageRecycler::kMaxMoves - 1) * kPage), 0x33);
+    EXPECT_EQ(recipient.at(PageRecycler::kMaxMoves * kPage), 0); // faulted in, not moved
+    EXPECT_EQ(donor.at(2 * (donations - 1) * kPage), 0);         // given back
+    recycler.donate(donor.data + kPage, kPage);                  // from now on: given back
+    EXPECT_EQ(donor.at(kPage), 0);
+}
+
+} // namespace
+} // namespace omicron
