@@ -17,9 +17,12 @@ namespace omicron {
 namespace {
 
 // The deep levels are written in one sweep over the cloud (omh_payload_sweep), a batch of
-// subtrees holding at most this many points at a time (for a cloud in a scratch file, up to a
-// 32nd of the budget's worth when that is more, at most the second constant): their splat
-// attributes are held until written.
+// subtrees holding at most this many points at a time: their splat attributes are held until
+// written. In memory, batches are small so that the last one, whose writing nothing overlaps,
+// is short (measured on 24.2 M points: 1 Mi saves 3 % of build --save against 4 Mi; 512 Ki
+// no more). For a cloud in a scratch file, an eighth of the budget's worth up to the second
+// constant, or a 32nd of it when that is more, up to the third: fewer, longer reads.
+constexpr std::uint64_t kInMemorySweepBatchPoints = std::uint64_t{1} << 20;
 constexpr std::uint64_t kSweepBatchPoints = std::uint64_t{4} << 20;
 constexpr std::uint64_t kFileBackedSweepBatchPoints = std::uint64_t{64} << 20;
 
@@ -273,7 +276,7 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
         cloud.fileBacked()
             ? std::max(std::clamp<std::uint64_t>(budgetPoints / 8, 1, kSweepBatchPoints),
                        std::min(budgetPoints / 32, kFileBackedSweepBatchPoints))
-            : kSweepBatchPoints;
+            : kInMemorySweepBatchPoints;
     const std::uint64_t sweepBatch =
         options.sweepBatchPoints > 0 ? options.sweepBatchPoints : defaultBatch;
     const SubtreePoints subtrees = subtreeHeldPoints(hierarchy);

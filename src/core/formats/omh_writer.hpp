@@ -19,7 +19,7 @@ struct OmhWriteOptions {
     // swept levels first. For the test that kills a save half-way (omicron-cli build --save).
     std::function<void(int level)> afterLevel;
     // Points held by a batch of the one-pass sweep that writes the deep levels (0: the
-    // default, 4 Mi; for a cloud in a scratch file at most an eighth of the budget's worth, or a
+    // default, 1 Mi; for a cloud in a scratch file at most an eighth of the budget's worth, or a
     // 32nd of it when that is more). The
     // bytes written do not depend on it; tests vary it.
     std::uint64_t sweepBatchPoints = 0;
