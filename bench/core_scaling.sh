@@ -28,13 +28,8 @@ cli=build/release/bin/omicron-cli
 [ -x "$cli" ] || { echo "core_scaling: build first (./scripts/build.sh)" >&2; exit 1; }
 [ -f "$cloud" ] || { echo "core_scaling: $cloud is absent" >&2; exit 77; }
 [ "$(nproc)" -ge 2 ] || { echo "core_scaling: needs two cores" >&2; exit 77; }
-work=$(mktemp -d "${BENCH_DIR:-/dev/shm}/omicron-core-scaling-XXXXXX")
-trap 'rm -rf "$work"' EXIT
 source bench/measure.sh
-
-input="$work/input.las"
-"$cli" tile "$cloud" "$input" --copies "$copies" > /dev/null
-points=$(points_in "$input")
+tile_input core-scaling "$cloud" "$copies"
 echo "bench=core_scaling step=input cloud=$(basename "$cloud") copies=$copies points=$points"
 
 declare -A walls

@@ -20,3 +20,14 @@ median() {
 points_in() {
   "$cli" info "$1" | awk '/^points:/ { print $2 }'
 }
+
+# Makes $work (a scratch folder under $BENCH_DIR, default /dev/shm, removed on exit) and tiles
+# CLOUD COPIES times into one LAS file there; sets $input and $points ($cli: omicron-cli).
+# usage: tile_input NAME CLOUD COPIES
+tile_input() {
+  work=$(mktemp -d "${BENCH_DIR:-/dev/shm}/omicron-$1-XXXXXX")
+  trap 'rm -rf "$work"' EXIT
+  input="$work/input.las"
+  "$cli" tile "$2" "$input" --copies "$3" > /dev/null
+  points=$(points_in "$input")
+}

@@ -6,15 +6,24 @@
 //    unsorted input between runs is not timed).
 // 2. The paper's figure 6 for K sort chunks in {1,2,4,8,16,32,64}: read time, time from the
 //    end of reading to the first sorted range, and total sort time after reading.
+// 3. The sort's page recycling (points/page_recycler.hpp) against giving the input's pages
+//    back and faulting the sorted cloud's in: the sort after reading and the minor page faults
+//    of the whole sortPointCloud (getrusage), medians of 5 alternating runs each.
+//      bench=sort_pages mode=fault|recycle points= sort_after_read_ms= minor_faults=
+//      pages_recycled= ... ; then speedup= and faults_ratio= on the recycle line.
 #include "bench_timing.hpp"
 #include "io/point_reader.hpp"
 #include "sort/morton_sorter.hpp"
 #include "sort/radix_sort.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <numeric>
+#include <stdexcept>
+#include <string>
+#include <sys/resource.h>
 #include <tbb/info.h>
 #include <tbb/parallel_sort.h>
 #include <vector>
@@ -28,6 +37,61 @@ struct KeyIndex {
     std::uint32_t index;
     bool operator<(const KeyIndex& other) const { return code < other.code; }
 };
+
+long minorFaults() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return usage.ru_minflt;
+}
+
+double median(std::vector<double> values) {
+    std::sort(values.begin(), values.end());
+    return values[values.size() / 2];
+}
+
+// Section 3: the same sort with the input's pages moved into the sorted cloud, and without.
+void measurePageRecycling(const std::string& path, std::size_t count) {
+    struct Mode {
+        const char* name;
+        bool recycle;
+        std::vector<double> sortMs, faults;
+        std::size_t recycled = 0;
+    };
+    std::array<Mode, 2> modes{Mode{"fault", false, {}, {}}, Mode{"recycle", true, {}, {}}};
+    for (int run = 0; run < 5; ++run) {
+        for (Mode& mode : modes) {
+            auto reader = omicron::openPointCloud(path);
+            omicron::SortOptions options;
+            options.recyclePages = mode.recycle;
+            std::size_t emitted = 0;
+            const long faultsBefore = minorFaults();
+            const omicron::SortSummary summary = omicron::sortPointCloud(
+                *reader, options,
+                [&](const omicron::SortedCloud&, std::size_t begin, std::size_t end) {
+                    emitted += end - begin;
+                });
+            if (emitted != count) {
+                throw std::runtime_error("sort_bench: a sort emitted " + std::to_string(emitted) +
+                                         " of " + std::to_string(count) + " points");
+            }
+            mode.sortMs.push_back(summary.sortAfterReadSeconds * 1e3);
+            mode.recycled = summary.pagesRecycled;
+            mode.faults.push_back(static_cast<double>(minorFaults() - faultsBefore));
+        }
+    }
+    const double faultMs = median(modes[0].sortMs);
+    const double faultFaults = median(modes[0].faults);
+    for (const Mode& mode : modes) {
+        std::printf("bench=sort_pages mode=%s points=%zu sort_after_read_ms=%.1f minor_faults=%.0f "
+                    "pages_recycled=%zu",
+                    mode.name, count, median(mode.sortMs), median(mode.faults), mode.recycled);
+        if (mode.recycle) {
+            std::printf(" speedup=%.2f faults_ratio=%.2f", faultMs / median(mode.sortMs),
+                        median(mode.faults) / faultFaults);
+        }
+        std::printf("\n");
+    }
+}
 
 } // namespace
 
@@ -114,6 +178,7 @@ int main(int argc, char** argv) {
                         best.firstRangeAfterReadSeconds / singleChunkSortS);
             std::fflush(stdout);
         }
+        measurePageRecycling(path, count);
     } catch (const std::exception& error) {
         std::fprintf(stderr, "sort_bench: %s\n", error.what());
         return 1;

@@ -31,13 +31,8 @@ potree=${POTREE:-$HOME/peers/PotreeConverter/build/PotreeConverter}
 [ -x "$cli" ] || { echo "vs_peers: build first (./scripts/build.sh)" >&2; exit 1; }
 [ -x "$potree" ] || { echo "vs_peers: PotreeConverter not found at $potree (see ../shared/peers/run-peers.sh)" >&2; exit 77; }
 [ -f "$cloud" ] || { echo "vs_peers: $cloud is absent" >&2; exit 77; }
-work=$(mktemp -d "${BENCH_DIR:-/dev/shm}/omicron-vs-peers-XXXXXX")
-trap 'rm -rf "$work"' EXIT
 source bench/measure.sh
-
-input="$work/input.las"
-"$cli" tile "$cloud" "$input" --copies "$copies" > /dev/null
-points=$(points_in "$input")
+tile_input vs-peers "$cloud" "$copies"
 echo "bench=vs_peers step=input cloud=$(basename "$cloud") copies=$copies points=$points bytes=$(stat -c %s "$input")"
 
 declare -A walls rsss

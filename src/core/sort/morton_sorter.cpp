@@ -454,6 +454,7 @@ SortSummary sortPointCloud(PointReader& reader, const SortOptions& options,
     }
     const auto sortStart = Clock::now();
     summary.chunksUsed = sorter.sortAndEmit(consumer);
+    summary.pagesRecycled = sorter.pagesRecycled();
     summary.sortAfterReadSeconds = secondsSince(sortStart);
     summary.firstRangeAfterReadSeconds = sorter.firstRangeSeconds();
     summary.cancelled = options.cancel != nullptr && options.cancel->load();

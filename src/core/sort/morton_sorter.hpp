@@ -168,6 +168,7 @@ struct SortSummary {
     double readSeconds = 0.0;             // open excluded: streaming the points into the sorter
     double firstRangeAfterReadSeconds = -1.0;
     double sortAfterReadSeconds = 0.0;    // read end -> last range handed to the consumer
+    std::size_t pagesRecycled = 0;        // see IncrementalMortonSorter::pagesRecycled()
     bool cancelled = false;
 };
 

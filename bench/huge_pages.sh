@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Huge pages against small ones for the whole `omicron-cli build --save` (OMICRON_HUGE_PAGES=1
+# and =0, alternating run by run, on a tmpfs so the disk is out of the comparison), each run
+# after an idle pause: the state a build usually starts from. It checks the choice
+# points/huge_page_policy.hpp makes for this machine (small pages where free memory is
+# reported to a hypervisor). Prints one line per run and a summary with the medians, the ratio
+# and what the policy picks here.
+#
+# usage: bench/huge_pages.sh CLOUD [--copies K] [--runs N] [--idle S]
+#   CLOUD    a PLY, LAS or LAZ file, tiled K times (default 1) into one LAS 1.2 file
+#            (omicron-cli tile); K = 5 makes 24.2 M points from autzen_south.
+#   --runs N runs with each page size (default 3); --idle S seconds before each (default 5).
+# Lines: bench=huge_pages pages=huge|small run=R points=P wall_s= user_s= sys_s= peak_rss_mib=
+#        bench=huge_pages summary points=P huge_wall_s= small_wall_s= small_speedup=
+#        reported_kib= policy=huge|small
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cloud=${1:?usage: bench/huge_pages.sh CLOUD [--copies K] [--runs N] [--idle S]}
+shift
+copies=1 runs=3 idle=5
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --copies) copies=$2; shift 2 ;;
+    --runs) runs=$2; shift 2 ;;
+    --idle) idle=$2; shift 2 ;;
+    *) echo "huge_pages: unknown option $1" >&2; exit 2 ;;
+  esac
+done
+cli=build/release/bin/omicron-cli
+[ -x "$cli" ] || { echo "huge_pages: build first (./scripts/build.sh)" >&2; exit 1; }
+[ -f "$cloud" ] || { echo "huge_pages: $cloud is absent" >&2; exit 77; }
+source bench/measure.sh
+tile_input huge-pages "$cloud" "$copies"
+echo "bench=huge_pages step=input cloud=$(basename "$cloud") copies=$copies points=$points"
+
+declare -A walls
+for run in $(seq 1 "$runs"); do
+  for pages in huge small; do
+    rm -f "$work/out.omh"
+    sleep "$idle"
+    flag=$([ "$pages" = huge ] && echo 1 || echo 0)
+    read -r wall user sys rss < <(OMICRON_HUGE_PAGES=$flag measure \
+      "$cli" build "$input" --save "$work/out.omh")
+    [ -s "$work/out.omh" ] || { echo "huge_pages: the build wrote nothing:" >&2; cat "$work/err.txt" >&2; exit 1; }
+    echo "bench=huge_pages pages=$pages run=$run points=$points wall_s=$wall user_s=$user sys_s=$sys peak_rss_mib=$((rss / 1024))"
+    walls[$pages]+="$wall "
+  done
+done
+
+huge=$(echo "${walls[huge]}" | median)
+small=$(echo "${walls[small]}" | median)
+reported=$(cat /sys/module/page_reporting/parameters/reported_kib 2>/dev/null || echo 0)
+policy=$([ "$reported" -gt 0 ] && echo small || echo huge)
+awk -v p="$points" -v h="$huge" -v s="$small" -v r="$reported" -v pol="$policy" 'BEGIN {
+  printf "bench=huge_pages summary points=%d huge_wall_s=%.2f small_wall_s=%.2f small_speedup=%.2f reported_kib=%s policy=%s\n", p, h, s, h / s, r, pol }'
