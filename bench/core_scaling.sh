@@ -35,10 +35,7 @@ echo "bench=core_scaling step=input cloud=$(basename "$cloud") copies=$copies po
 declare -A walls
 for run in $(seq 1 "$runs"); do
   for cores in 1 2; do
-    rm -f "$work/out.omh"
-    read -r wall user sys rss < <(measure taskset -c "0-$((cores - 1))" \
-      "$cli" build "$input" --save "$work/out.omh")
-    [ -s "$work/out.omh" ] || { echo "core_scaling: the build wrote nothing:" >&2; cat "$work/err.txt" >&2; exit 1; }
+    read -r wall user sys rss < <(measure_build core_scaling taskset -c "0-$((cores - 1))")
     echo "bench=core_scaling cores=$cores run=$run points=$points wall_s=$wall user_s=$user sys_s=$sys peak_rss_mib=$((rss / 1024))"
     walls[$cores]+="$wall "
   done

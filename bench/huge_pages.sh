@@ -36,12 +36,9 @@ echo "bench=huge_pages step=input cloud=$(basename "$cloud") copies=$copies poin
 declare -A walls
 for run in $(seq 1 "$runs"); do
   for pages in huge small; do
-    rm -f "$work/out.omh"
     sleep "$idle"
     flag=$([ "$pages" = huge ] && echo 1 || echo 0)
-    read -r wall user sys rss < <(OMICRON_HUGE_PAGES=$flag measure \
-      "$cli" build "$input" --save "$work/out.omh")
-    [ -s "$work/out.omh" ] || { echo "huge_pages: the build wrote nothing:" >&2; cat "$work/err.txt" >&2; exit 1; }
+    read -r wall user sys rss < <(measure_build huge_pages env OMICRON_HUGE_PAGES="$flag")
     echo "bench=huge_pages pages=$pages run=$run points=$points wall_s=$wall user_s=$user sys_s=$sys peak_rss_mib=$((rss / 1024))"
     walls[$pages]+="$wall "
   done

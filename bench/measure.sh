@@ -31,3 +31,21 @@ tile_input() {
   "$cli" tile "$2" "$input" --copies "$3" > /dev/null
   points=$(points_in "$input")
 }
+
+# One `omicron-cli build $input --save $work/out.omh`, after PREFIX (e.g. `taskset -c 0` or
+# `env VAR=1`): prints "wall_s user_s sys_s peak_kib", or nothing (and the build's errors on
+# stderr) when no .omh was written, so that a `read` of it fails the calling script.
+# usage: measure_build NAME [PREFIX...]
+measure_build() {
+  local name=$1
+  shift
+  rm -f "$work/out.omh"
+  local figures
+  figures=$(measure "$@" "$cli" build "$input" --save "$work/out.omh")
+  if [ -s "$work/out.omh" ]; then
+    echo "$figures"
+  else
+    echo "$name: the build wrote nothing:" >&2
+    cat "$work/err.txt" >&2
+  fi
+}
