@@ -77,12 +77,11 @@ inline void adviseWholePages(const void* memory, std::size_t bytes, std::size_t 
 
 // Advises huge pages for the whole 2 MiB pages inside [memory, memory + bytes): for a large
 // buffer allocated elsewhere (a reserved std::vector) and not touched yet, so its first touch
-// takes a fault per 2 MiB instead of per 4 KiB. Advice only: a refusal changes nothing, and
-// none is given where huge pages do not pay off.
+// takes a fault per 2 MiB instead of per 4 KiB. Advice only: a refusal changes nothing. Where
+// huge pages do not pay off it advises against them (a kernel set to "always" would use them).
 inline void adviseHugePages(const void* memory, std::size_t bytes) {
-    if (hugePagesPayOff()) {
-        adviseWholePages(memory, bytes, kHugePageBytes, MADV_HUGEPAGE);
-    }
+    adviseWholePages(memory, bytes, kHugePageBytes,
+                     hugePagesPayOff() ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
 }
 
 // Gives back the whole small pages inside [memory, memory + bytes) of an anonymous buffer whose
