@@ -123,7 +123,7 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
     advise(m_input.las);
     if (m_options.recyclePages.value_or(!hugePagesPayOff())) {
         const SortedCloud::InPlaceArrays sorted = m_cloud->inPlaceArrays();
-        const std::array<std::span<std::byte>, 5> recipients{
+        const std::array<std::span<std::byte>, kColumns> recipients{
             sorted.positions, sorted.normals, sorted.colors, sorted.intensities, sorted.las};
         for (std::size_t column = 0; column < recipients.size(); ++column) {
             if (!recipients[column].empty()) {
@@ -229,15 +229,15 @@ void IncrementalMortonSorter::releaseInputBlock(std::size_t block) {
             releasePages(memory + begin * pointBytes, count * pointBytes);
         }
     };
-    release(0, m_input.positions, sizeof(glm::vec3));
-    release(1, m_input.normals, sizeof(glm::vec3));
-    release(2, m_input.colors, sizeof(glm::u8vec3));
-    release(3, m_input.intensities, sizeof(std::uint16_t));
-    release(4, m_input.las, m_input.attributes.lasBytes());
+    release(kPositions, m_input.positions, sizeof(glm::vec3));
+    release(kNormals, m_input.normals, sizeof(glm::vec3));
+    release(kColors, m_input.colors, sizeof(glm::u8vec3));
+    release(kIntensities, m_input.intensities, sizeof(std::uint16_t));
+    release(kLas, m_input.las, m_input.attributes.lasBytes());
 }
 
 void IncrementalMortonSorter::prepareRecycledPages(const SortedCloud::StagedRange& out) {
-    const std::array<const void*, 5> ends{
+    const std::array<const void*, kColumns> ends{
         out.positions.data() + out.positions.size(), out.normals.data() + out.normals.size(),
         out.colors.data() + out.colors.size(), out.intensities.data() + out.intensities.size(),
         out.las.data() + out.las.size()};

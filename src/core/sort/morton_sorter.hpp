@@ -146,9 +146,10 @@ private:
 
     // Input in arrival order (attributes are gathered from here into the sorted cloud).
     PointBatch m_input;
-    // Per column (positions, normals, colours, intensities, LAS): where the input's pages go
-    // when given back; null: back to the kernel.
-    std::array<std::unique_ptr<PageRecycler>, 5> m_recyclers;
+    // Per column, in this order: where the input's pages go when given back (null: back to
+    // the kernel).
+    enum Column : std::size_t { kPositions, kNormals, kColors, kIntensities, kLas, kColumns };
+    std::array<std::unique_ptr<PageRecycler>, kColumns> m_recyclers;
     std::size_t m_pagesRecycled = 0;
     std::vector<Bin> m_bins;
     std::vector<std::uint16_t> m_blockLastBin;
