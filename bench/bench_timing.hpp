@@ -1,8 +1,10 @@
-// Timing helpers shared by the benchmarks: wall-clock seconds, best of N runs.
+// Timing helpers shared by the benchmarks: wall-clock seconds, best of N runs, quantiles.
 #pragma once
 
 #include <algorithm>
 #include <chrono>
+#include <cstddef>
+#include <vector>
 
 namespace omicron::bench {
 
@@ -27,6 +29,17 @@ template <typename Reset, typename Fn> double bestSeconds(int runs, Reset&& rese
 template <typename Fn> double bestSeconds(int runs, Fn&& fn) {
     return bestSeconds(
         runs, [] {}, fn);
+}
+
+// The q-quantile of `values` (q = 0.5: the median; the upper one of an even count); 0 when
+// there are none.
+template <typename T> double quantile(std::vector<T> values, double q) {
+    if (values.empty()) {
+        return 0.0;
+    }
+    const std::size_t k = std::min(values.size() - 1, static_cast<std::size_t>(q * values.size()));
+    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+    return static_cast<double>(values[k]);
 }
 
 } // namespace omicron::bench

@@ -14,21 +14,10 @@
 #        bench=core_scaling summary points=P one_core_wall_s= two_cores_wall_s= speedup=
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cloud=${1:?usage: bench/core_scaling.sh CLOUD [--copies K] [--runs N]}
-shift
-copies=1 runs=5
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --copies) copies=$2; shift 2 ;;
-    --runs) runs=$2; shift 2 ;;
-    *) echo "core_scaling: unknown option $1" >&2; exit 2 ;;
-  esac
-done
-cli=build/release/bin/omicron-cli
-[ -x "$cli" ] || { echo "core_scaling: build first (./scripts/build.sh)" >&2; exit 1; }
-[ -f "$cloud" ] || { echo "core_scaling: $cloud is absent" >&2; exit 77; }
-[ "$(nproc)" -ge 2 ] || { echo "core_scaling: needs two cores" >&2; exit 77; }
 source bench/measure.sh
+copies=1 runs=5
+parse_cloud_args core_scaling "" "$@"
+[ "$(nproc)" -ge 2 ] || { echo "core_scaling: needs two cores" >&2; exit 77; }
 tile_input core-scaling "$cloud" "$copies"
 echo "bench=core_scaling step=input cloud=$(basename "$cloud") copies=$copies points=$points"
 

@@ -31,18 +31,10 @@
 namespace {
 
 using omicron::bench::Clock;
+using omicron::bench::quantile;
 using omicron::bench::secondsSince;
 
 constexpr double kFrameSeconds = 1.0 / 60.0;
-
-template <typename T> double quantile(std::vector<T> values, double q) {
-    if (values.empty()) {
-        return 0.0;
-    }
-    const std::size_t k = std::min(values.size() - 1, static_cast<std::size_t>(q * values.size()));
-    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
-    return static_cast<double>(values[k]);
-}
 
 template <typename T> double maximum(const std::vector<T>& values) {
     return values.empty() ? 0.0 : static_cast<double>(*std::max_element(values.begin(), values.end()));

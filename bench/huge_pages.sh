@@ -15,21 +15,9 @@
 #        reported_kib= policy=huge|small
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cloud=${1:?usage: bench/huge_pages.sh CLOUD [--copies K] [--runs N] [--idle S]}
-shift
-copies=1 runs=3 idle=5
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --copies) copies=$2; shift 2 ;;
-    --runs) runs=$2; shift 2 ;;
-    --idle) idle=$2; shift 2 ;;
-    *) echo "huge_pages: unknown option $1" >&2; exit 2 ;;
-  esac
-done
-cli=build/release/bin/omicron-cli
-[ -x "$cli" ] || { echo "huge_pages: build first (./scripts/build.sh)" >&2; exit 1; }
-[ -f "$cloud" ] || { echo "huge_pages: $cloud is absent" >&2; exit 77; }
 source bench/measure.sh
+copies=1 runs=3 idle=5
+parse_cloud_args huge_pages "idle" "$@"
 tile_input huge-pages "$cloud" "$copies"
 echo "bench=huge_pages step=input cloud=$(basename "$cloud") copies=$copies points=$points"
 

@@ -1,4 +1,4 @@
-# Shared by the benchmark scripts (source it). measure: runs a command under /usr/bin/time -v
+# Shared by the benchmark scripts (source it from the repository root). measure: runs a command under /usr/bin/time -v
 # with its output in $work/out.txt and $work/err.txt ($work: a scratch folder), and prints
 # "wall_s user_s sys_s peak_kib".
 # shellcheck shell=bash
@@ -48,4 +48,28 @@ measure_build() {
     echo "$name: the build wrote nothing:" >&2
     cat "$work/err.txt" >&2
   fi
+}
+
+# The arguments of a benchmark on a tiled cloud: CLOUD, then --copies K, --runs N and the
+# options named in EXTRA (e.g. "idle" for --idle S), each setting the variable of its name (set
+# the defaults first). Sets $cloud and $cli (omicron-cli, which must be built); exits 2 on a
+# usage error, 77 (skipped) when CLOUD is absent.
+# usage: parse_cloud_args NAME "EXTRA" "$@"
+parse_cloud_args() {
+  local name=$1 allowed=" copies runs $2 "
+  shift 2
+  cloud=${1:?usage: bench/$name.sh CLOUD [--copies K] [--runs N] ...}
+  shift
+  while [ $# -gt 0 ]; do
+    local option=${1#--}
+    if [[ ! $option =~ ^[a-z]+$ || $allowed != *" $option "* || $# -lt 2 ]]; then
+      echo "$name: unknown option or missing value: $1" >&2
+      exit 2
+    fi
+    printf -v "$option" '%s' "$2"
+    shift 2
+  done
+  cli=build/release/bin/omicron-cli
+  [ -x "$cli" ] || { echo "$name: build first (./scripts/build.sh)" >&2; exit 1; }
+  [ -f "$cloud" ] || { echo "$name: $cloud is absent" >&2; exit 77; }
 }

@@ -31,6 +31,7 @@
 namespace {
 
 using omicron::bench::bestSeconds;
+using omicron::bench::quantile;
 
 struct KeyIndex {
     std::uint64_t code;
@@ -42,11 +43,6 @@ long minorFaults() {
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     return usage.ru_minflt;
-}
-
-double median(std::vector<double> values) {
-    std::sort(values.begin(), values.end());
-    return values[values.size() / 2];
 }
 
 // Section 3: the same sort with the input's pages moved into the sorted cloud, and without.
@@ -79,15 +75,15 @@ void measurePageRecycling(const std::string& path, std::size_t count) {
             mode.faults.push_back(static_cast<double>(minorFaults() - faultsBefore));
         }
     }
-    const double faultMs = median(modes[0].sortMs);
-    const double faultFaults = median(modes[0].faults);
+    const double faultMs = quantile(modes[0].sortMs, 0.5);
+    const double faultFaults = quantile(modes[0].faults, 0.5);
     for (const Mode& mode : modes) {
         std::printf("bench=sort_pages mode=%s points=%zu sort_after_read_ms=%.1f minor_faults=%.0f "
                     "pages_recycled=%zu",
-                    mode.name, count, median(mode.sortMs), median(mode.faults), mode.recycled);
+                    mode.name, count, quantile(mode.sortMs, 0.5), quantile(mode.faults, 0.5), mode.recycled);
         if (mode.recycle) {
-            std::printf(" speedup=%.2f faults_ratio=%.2f", faultMs / median(mode.sortMs),
-                        median(mode.faults) / faultFaults);
+            std::printf(" speedup=%.2f faults_ratio=%.2f", faultMs / quantile(mode.sortMs, 0.5),
+                        quantile(mode.faults, 0.5) / faultFaults);
         }
         std::printf("\n");
     }

@@ -16,22 +16,11 @@
 #        peak_rss_mib= ; bench=vs_peers summary ... speedup=(potree / omicron wall time)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cloud=${1:?usage: bench/vs_peers.sh CLOUD [--copies K] [--runs N]}
-shift
-copies=1 runs=3
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --copies) copies=$2; shift 2 ;;
-    --runs) runs=$2; shift 2 ;;
-    *) echo "vs_peers: unknown option $1" >&2; exit 2 ;;
-  esac
-done
-cli=build/release/bin/omicron-cli
-potree=${POTREE:-$HOME/peers/PotreeConverter/build/PotreeConverter}
-[ -x "$cli" ] || { echo "vs_peers: build first (./scripts/build.sh)" >&2; exit 1; }
-[ -x "$potree" ] || { echo "vs_peers: PotreeConverter not found at $potree (see ../shared/peers/run-peers.sh)" >&2; exit 77; }
-[ -f "$cloud" ] || { echo "vs_peers: $cloud is absent" >&2; exit 77; }
 source bench/measure.sh
+copies=1 runs=3
+parse_cloud_args vs_peers "" "$@"
+potree=${POTREE:-$HOME/peers/PotreeConverter/build/PotreeConverter}
+[ -x "$potree" ] || { echo "vs_peers: PotreeConverter not found at $potree (see ../shared/peers/run-peers.sh)" >&2; exit 77; }
 tile_input vs-peers "$cloud" "$copies"
 echo "bench=vs_peers step=input cloud=$(basename "$cloud") copies=$copies points=$points bytes=$(stat -c %s "$input")"
 

@@ -63,15 +63,24 @@ void dropResidentPages(void* memory, std::size_t bytes);
 
 inline constexpr std::size_t kSmallPageBytes = 4096;
 
+// The whole pages of `pageBytes` (a power of two) inside [memory, memory + bytes), as the
+// addresses [first, last); none when last <= first.
+struct WholePages {
+    std::uintptr_t first;
+    std::uintptr_t last;
+};
+inline WholePages wholePages(const void* memory, std::size_t bytes, std::size_t pageBytes) {
+    const auto begin = reinterpret_cast<std::uintptr_t>(memory);
+    return {(begin + pageBytes - 1) & ~(pageBytes - 1), (begin + bytes) & ~(pageBytes - 1)};
+}
+
 // madvise(advice) on the whole pages of `pageBytes` (a power of two) inside
 // [memory, memory + bytes); nothing when there are none.
 inline void adviseWholePages(const void* memory, std::size_t bytes, std::size_t pageBytes,
                              int advice) {
-    const auto begin = reinterpret_cast<std::uintptr_t>(memory);
-    const std::uintptr_t first = (begin + pageBytes - 1) & ~(pageBytes - 1);
-    const std::uintptr_t last = (begin + bytes) & ~(pageBytes - 1);
-    if (last > first) {
-        madvise(reinterpret_cast<void*>(first), last - first, advice);
+    const WholePages pages = wholePages(memory, bytes, pageBytes);
+    if (pages.last > pages.first) {
+        madvise(reinterpret_cast<void*>(pages.first), pages.last - pages.first, advice);
     }
 }
 

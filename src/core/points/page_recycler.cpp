@@ -19,15 +19,12 @@ constexpr std::uintptr_t kPage = kSmallPageBytes;
 std::uintptr_t pageUp(std::uintptr_t address) {
     return (address + kPage - 1) & ~(kPage - 1);
 }
-std::uintptr_t pageDown(std::uintptr_t address) {
-    return address & ~(kPage - 1);
-}
 
 } // namespace
 
 PageRecycler::PageRecycler(std::span<std::byte> recipient)
     : m_frontier(reinterpret_cast<std::uintptr_t>(recipient.data())),
-      m_end(pageDown(m_frontier + recipient.size())) {
+      m_end(wholePages(recipient.data(), recipient.size(), kPage).last) {
     assert(m_frontier % kPage == 0);
 }
 
@@ -36,9 +33,7 @@ PageRecycler::~PageRecycler() {
 }
 
 void PageRecycler::donate(const void* memory, std::size_t bytes) {
-    const auto address = reinterpret_cast<std::uintptr_t>(memory);
-    const std::uintptr_t first = pageUp(address);
-    const std::uintptr_t last = pageDown(address + bytes);
+    const auto [first, last] = wholePages(memory, bytes, kPage);
     if (last <= first) {
         return;
     }
