@@ -18,6 +18,11 @@ void OverlappedBatchConsumer::push(const PointBatch& batch) {
         std::rethrow_exception(m_failure);
     }
     m_waiting = batch; // reuses the buffer's capacity after the first batches
+    m_waitingCodes.resize(batch.size());
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+        const glm::vec3& p = batch.positions[i];
+        m_waitingCodes[i] = morton::encodeUnit(p.x, p.y, p.z);
+    }
     m_hasWaiting = true;
     m_changed.notify_all();
 }
@@ -36,6 +41,7 @@ void OverlappedBatchConsumer::finish() {
 
 void OverlappedBatchConsumer::work(std::stop_token stop) {
     PointBatch working;
+    std::vector<morton::Code> workingCodes;
     while (true) {
         {
             std::unique_lock lock(m_mutex);
@@ -47,11 +53,12 @@ void OverlappedBatchConsumer::work(std::stop_token stop) {
                 return; // the reader gave up: what waits is dropped
             }
             std::swap(working, m_waiting);
+            std::swap(workingCodes, m_waitingCodes);
             m_hasWaiting = false;
         }
         m_changed.notify_all(); // the reader may copy the next batch meanwhile
         try {
-            m_consume(working);
+            m_consume(working, workingCodes);
         } catch (...) {
             {
                 std::lock_guard lock(m_mutex);

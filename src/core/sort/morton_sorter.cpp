@@ -134,11 +134,6 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
 }
 
 void IncrementalMortonSorter::add(const PointBatch& batch) {
-    const std::size_t firstIndex = m_pointsAdded;
-    if (firstIndex + batch.size() > m_cloud->capacity()) {
-        throw std::length_error(m_info.path + ": the reader delivered more points than the " +
-                                std::to_string(m_cloud->capacity()) + " its header declared");
-    }
     const std::size_t count = batch.size();
     m_batchCodes.resize(count);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 8192),
@@ -148,16 +143,27 @@ void IncrementalMortonSorter::add(const PointBatch& batch) {
                               m_batchCodes[i] = morton::encodeUnit(p.x, p.y, p.z);
                           }
                       });
+    add(batch, m_batchCodes);
+}
+
+void IncrementalMortonSorter::add(const PointBatch& batch, std::span<const morton::Code> codes) {
+    assert(codes.size() == batch.size());
+    const std::size_t firstIndex = m_pointsAdded;
+    if (firstIndex + batch.size() > m_cloud->capacity()) {
+        throw std::length_error(m_info.path + ": the reader delivered more points than the " +
+                                std::to_string(m_cloud->capacity()) + " its header declared");
+    }
+    const std::size_t count = batch.size();
     m_pointsAdded += count;
     m_preview.add(batch, firstIndex);
     if (m_spiller) {
-        m_spiller->add(batch, m_batchCodes);
+        m_spiller->add(batch, codes);
         return;
     }
     // The counting pass and first distribution, done while the data arrives.
     constexpr int binShift = 3 * morton::kMaxLevel - kBinBits;
     for (std::size_t i = 0; i < count; ++i) {
-        const morton::Code code = m_batchCodes[i];
+        const morton::Code code = codes[i];
         const auto binIndex = static_cast<std::uint16_t>((code >> binShift) & (kBins - 1));
         m_bins[binIndex].push(static_cast<std::uint32_t>(firstIndex + i));
         std::uint16_t& lastBin = m_blockLastBin[(firstIndex + i) >> kReleaseBlockBits];
@@ -442,7 +448,10 @@ SortSummary sortPointCloud(PointReader& reader, const SortOptions& options,
     readOptions.cancel = options.cancel;
     const auto readStart = Clock::now();
     // The sorter takes each batch on a thread of its own while the reader parses the next.
-    OverlappedBatchConsumer sorterInput([&](const PointBatch& batch) { sorter.add(batch); });
+    OverlappedBatchConsumer sorterInput(
+        [&](const PointBatch& batch, std::span<const morton::Code> codes) {
+            sorter.add(batch, codes);
+        });
     summary.read =
         reader.read([&](const PointBatch& batch) { sorterInput.push(batch); }, readOptions);
     sorterInput.finish();

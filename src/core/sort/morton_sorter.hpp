@@ -82,6 +82,9 @@ public:
 
     // Reading phase (one thread): appends a batch in the unit cube of info.cube.
     void add(const PointBatch& batch);
+    // The same with the batch's level-21 codes already computed (morton::encodeUnit of each
+    // position, one per point), as OverlappedBatchConsumer hands them over.
+    void add(const PointBatch& batch, std::span<const morton::Code> codes);
 
     // Any thread, any time: a copy of the current preview sample (bounded size).
     PreviewSample preview() const;

@@ -1,24 +1,30 @@
 // The reader's batches consumed on a thread of their own: every batch once, in order, with its
-// content; a consumer's exception reaches the reader; giving up part way neither hangs nor
+// content and its points' Morton codes; a consumer's exception reaches the reader; giving up part way neither hangs nor
 // consumes what was left waiting.
 #include "io/overlapped_batch_consumer.hpp"
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <gtest/gtest.h>
 #include <stdexcept>
+#include <span>
 #include <thread>
 #include <vector>
 
 namespace omicron {
 namespace {
 
-// Batch k holds k % 7 + 1 points whose x is the running point index.
+// Batch k holds k % 7 + 1 points whose x is the running point index / 4096 (exact in a float,
+// inside the unit cube for the tests' point counts) and whose y and z vary with it.
 PointBatch batchNumber(std::size_t k, std::size_t& nextPoint) {
     PointBatch batch;
     batch.attributes = AttributeSet(Attribute::Intensity);
     for (std::size_t i = 0; i < k % 7 + 1; ++i) {
-        batch.positions.emplace_back(static_cast<float>(nextPoint++), 0.0f, 0.0f);
+        const auto index = static_cast<float>(nextPoint++);
+        batch.positions.emplace_back(index / 4096.0f, 1.0f - index / 8192.0f,
+                                     (index * 7.0f - 4096.0f * std::floor(index * 7.0f / 4096.0f)) /
+                                         4096.0f);
         batch.intensities.push_back(static_cast<std::uint16_t>(k));
     }
     return batch;
@@ -30,11 +36,16 @@ TEST(OverlappedBatchConsumer, ConsumesEveryBatchOnceInOrderWithItsContent) {
         std::vector<std::uint16_t> batchOfPoint;
         const std::thread::id reader = std::this_thread::get_id();
         bool otherThread = true;
-        OverlappedBatchConsumer consumer([&](const PointBatch& batch) {
+        std::size_t wrongCodes = 0;
+        OverlappedBatchConsumer consumer([&](const PointBatch& batch,
+                                             std::span<const morton::Code> codes) {
             otherThread = otherThread && std::this_thread::get_id() != reader;
+            ASSERT_EQ(codes.size(), batch.size());
             for (std::size_t i = 0; i < batch.size(); ++i) {
-                xs.push_back(batch.positions[i].x);
+                const glm::vec3& p = batch.positions[i];
+                xs.push_back(p.x);
                 batchOfPoint.push_back(batch.intensities[i]);
+                wrongCodes += codes[i] != morton::encodeUnit(p.x, p.y, p.z) ? 1 : 0;
             }
             std::this_thread::sleep_for(delay); // a consumer slower than the reader
         });
@@ -50,15 +61,16 @@ TEST(OverlappedBatchConsumer, ConsumesEveryBatchOnceInOrderWithItsContent) {
         EXPECT_TRUE(otherThread);
         ASSERT_EQ(xs.size(), nextPoint);
         for (std::size_t i = 0; i < xs.size(); ++i) {
-            ASSERT_EQ(xs[i], static_cast<float>(i)) << "point " << i;
+            ASSERT_EQ(xs[i], static_cast<float>(i) / 4096.0f) << "point " << i;
         }
         EXPECT_EQ(batchOfPoint, expectedBatches);
+        EXPECT_EQ(wrongCodes, 0u);
     }
 }
 
 TEST(OverlappedBatchConsumer, TheConsumersExceptionReachesTheReader) {
     std::atomic<std::size_t> consumed{0};
-    OverlappedBatchConsumer consumer([&](const PointBatch&) {
+    OverlappedBatchConsumer consumer([&](const PointBatch&, std::span<const morton::Code>) {
         if (consumed.fetch_add(1) == 5) {
             throw std::length_error("more points than declared");
         }
@@ -82,7 +94,7 @@ TEST(OverlappedBatchConsumer, GivingUpPartWayDropsWhatWaitsAndJoins) {
     std::atomic<std::size_t> consumed{0};
     std::size_t pushed = 0;
     {
-        OverlappedBatchConsumer consumer([&](const PointBatch&) {
+        OverlappedBatchConsumer consumer([&](const PointBatch&, std::span<const morton::Code>) {
             std::this_thread::sleep_for(std::chrono::milliseconds(20));
             consumed.fetch_add(1);
         });
