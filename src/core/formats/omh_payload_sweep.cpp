@@ -176,10 +176,20 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
         }
         return end;
     };
-    // A built hierarchy's subtrees cover one stretch of the cloud: read it in bulk.
+    // A built hierarchy's subtrees cover one stretch of the cloud: read it in bulk, on a
+    // thread of its own (the kernel submits a read-ahead's reads as it goes, and waits when the
+    // device's queue is full), one batch ahead of the estimation. No-op in memory.
+    std::future<void> reading; // the read-ahead in flight; its destructor waits for it
     const auto readAhead = [&](std::size_t begin, std::size_t end) {
-        cloud.willRead(hierarchy.node(firstLevel, begin).coveredBegin,
-                       coveredEnd(hierarchy.node(firstLevel, end - 1)));
+        if (!cloud.fileBacked()) {
+            return;
+        }
+        if (reading.valid()) {
+            reading.get();
+        }
+        const std::uint64_t from = hierarchy.node(firstLevel, begin).coveredBegin;
+        const std::uint64_t to = coveredEnd(hierarchy.node(firstLevel, end - 1));
+        reading = std::async(std::launch::async, [&cloud, from, to] { cloud.willRead(from, to); });
     };
     std::size_t end = roots > 0 ? batchEnd(0) : 0;
     if (roots > 0) {

@@ -30,6 +30,9 @@
 namespace omicron {
 
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
+// Bytes per read-ahead hint to the kernel (HugePageArray::willRead): at most what it reads per
+// hint on common devices (its window is the larger of read_ahead_kb and the largest request).
+inline constexpr std::uintptr_t kReadAheadChunkBytes = std::uintptr_t{1} << 20;
 
 // The bytes an array of `bytes` takes: a whole number of huge pages.
 constexpr std::size_t hugePageArrayBytes(std::size_t bytes) {
@@ -143,14 +146,23 @@ public:
     operator std::span<const T>() const { return {m_data.get(), m_size}; }
 
     bool fileBacked() const { return m_mappedBytes != 0; }
-    // File-backed only: elements [begin, end) will be read soon; the kernel starts reading
-    // them into the page cache (they are not mapped: the resident set does not grow).
+    // File-backed only: elements [begin, end) will be read soon; the kernel reads them into
+    // the page cache (they are not mapped: the resident set does not grow). One hint per
+    // kReadAheadChunkBytes: the kernel reads at most its read-ahead window (read_ahead_kb, or
+    // the device's largest request) per hint and silently drops the rest, so one hint for a
+    // batch of hundreds of MB read 8 MB of it and the save then waited on a fault per window
+    // (measured beyond the budget: 85 MB/s from a disk that reads 1.4 GB/s). The kernel
+    // submits the reads as it goes, waiting when the device's queue is full: call it from a
+    // thread that has nothing else to do.
     void willRead(std::size_t begin, std::size_t end) const {
         if (m_mappedBytes != 0 && begin < end) {
             const std::uintptr_t base = reinterpret_cast<std::uintptr_t>(m_data.get());
             const std::uintptr_t first = (base + begin * sizeof(T)) & ~std::uintptr_t{4095};
             const std::uintptr_t last = base + std::min(end, m_size) * sizeof(T);
-            madvise(reinterpret_cast<void*>(first), last - first, MADV_WILLNEED);
+            for (std::uintptr_t at = first; at < last; at += kReadAheadChunkBytes) {
+                const std::uintptr_t length = std::min<std::uintptr_t>(kReadAheadChunkBytes, last - at);
+                madvise(reinterpret_cast<void*>(at), length, MADV_WILLNEED);
+            }
         }
     }
     // File-backed only: stores `values` at elements [first, first + values.size()) with a
