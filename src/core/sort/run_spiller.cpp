@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <numeric>
 #include <tbb/parallel_for.h>
+#include <utility>
 
 namespace omicron {
 
@@ -18,9 +19,10 @@ constexpr std::size_t kWriteBlockBytes = std::size_t{4} << 20;
 } // namespace
 
 std::size_t RunSpiller::bytesPerBufferedPoint(AttributeSet attributes) {
-    // code, then the sort's key + index and their scratch copies.
-    return pointBytes(attributes) + sizeof(morton::Code) +
-           2 * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
+    // Record and code in each of the two buffers, then the sort's index, the index's scratch
+    // copy and the codes' scratch copy.
+    return 2 * (pointBytes(attributes) + sizeof(morton::Code)) + 2 * sizeof(std::uint32_t) +
+           sizeof(std::uint64_t);
 }
 
 RunSpiller::RunSpiller(const std::string& tempParent, AttributeSet attributes,
@@ -38,9 +40,12 @@ RunSpiller::RunSpiller(const std::string& tempParent, AttributeSet attributes,
                           "--temp-dir");
     }
     m_buffer.attributes = attributes;
-    // Reserved, not touched: pages become resident as the run fills, and never move.
+    m_spilled.attributes = attributes;
+    // Reserved, not touched: pages become resident as the runs fill, and never move.
     m_buffer.reserve(m_runPoints);
     m_codes.reserve(m_runPoints);
+    m_spilled.reserve(m_runPoints);
+    m_spilledCodes.reserve(m_runPoints);
 }
 
 void RunSpiller::add(const PointBatch& batch, std::span<const morton::Code> codes) {
@@ -51,34 +56,55 @@ void RunSpiller::add(const PointBatch& batch, std::span<const morton::Code> code
         m_codes.insert(m_codes.end(), codes.begin() + first, codes.begin() + first + take);
         first += take;
         if (m_buffer.size() == m_runPoints) {
-            spill();
+            startSpill();
         }
     }
 }
 
 void RunSpiller::finish() {
     if (!m_buffer.empty()) {
-        spill();
+        startSpill();
     }
-    PointBatch released; // the buffers' memory goes back before the merge needs its own
-    released.attributes = m_buffer.attributes;
-    m_buffer = std::move(released);
+    collectSpill();
+    // The buffers' memory goes back before the merge needs its own.
+    for (PointBatch* buffer : {&m_buffer, &m_spilled}) {
+        PointBatch released;
+        released.attributes = buffer->attributes;
+        *buffer = std::move(released);
+    }
     m_codes = {};
+    m_spilledCodes = {};
 }
 
-void RunSpiller::spill() {
-    const std::size_t n = m_buffer.size();
+void RunSpiller::collectSpill() {
+    if (m_spilling.valid()) {
+        m_runs.push_back(m_spilling.get());
+    }
+}
+
+void RunSpiller::startSpill() {
+    collectSpill(); // the other buffer is free again
+    std::swap(m_buffer, m_spilled);
+    std::swap(m_codes, m_spilledCodes);
+    m_buffer.clear();
+    m_codes.clear();
+    m_spilling = std::async(std::launch::async,
+                            [this, index = m_runsStarted++] { return writeRun(index); });
+}
+
+SortedRun RunSpiller::writeRun(std::size_t index) {
+    const std::size_t n = m_spilled.size();
     // Stable: equal codes keep their input order, which the merge then keeps across runs.
     std::vector<std::uint32_t> order(n), orderScratch(n);
     std::iota(order.begin(), order.end(), 0u);
     std::vector<std::uint64_t> keyScratch(n);
-    radixSortByKey(std::span(m_codes.data(), n), std::span(order.data(), n),
+    radixSortByKey(std::span(m_spilledCodes.data(), n), std::span(order.data(), n),
                    std::span(keyScratch.data(), n), std::span(orderScratch.data(), n));
     keyScratch = {};
     orderScratch = {};
 
     SortedRun run;
-    run.file = std::make_unique<ScratchFile>(m_folder, "run-" + std::to_string(m_runs.size()));
+    run.file = std::make_unique<ScratchFile>(m_folder, "run-" + std::to_string(index));
     run.points = n;
     const std::size_t recordsPerBlock = std::max<std::size_t>(1, kWriteBlockBytes / m_layout.bytes);
     std::vector<std::uint8_t> block;
@@ -88,15 +114,13 @@ void RunSpiller::spill() {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 16384),
                           [&](const tbb::blocked_range<std::size_t>& range) {
                               for (std::size_t i = range.begin(); i < range.end(); ++i) {
-                                  encodePointRecord(m_layout, m_buffer, order[first + i],
+                                  encodePointRecord(m_layout, m_spilled, order[first + i],
                                                     block.data() + i * m_layout.bytes);
                               }
                           });
         run.file->write(block.data(), block.size());
     }
-    m_runs.push_back(std::move(run));
-    m_buffer.clear();
-    m_codes.clear();
+    return run;
 }
 
 } // namespace omicron
