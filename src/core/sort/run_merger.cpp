@@ -43,6 +43,16 @@ bool RunMerger::refill(Cursor& cursor) {
     cursor.nextToLoad += count;
     cursor.at = 0;
     cursor.buffered = count;
+    if (cursor.nextToLoad < cursor.points) {
+        if (m_readAhead.valid()) {
+            m_readAhead.get(); // long done: another run's buffer was merged meanwhile
+        }
+        const ScratchFile* file = cursor.file;
+        const std::uint64_t offset = cursor.nextToLoad * m_layout.bytes;
+        const std::uint64_t bytes = std::uint64_t{m_recordsPerBuffer} * m_layout.bytes;
+        m_readAhead = std::async(std::launch::async,
+                                 [file, offset, bytes] { file->willRead(offset, bytes); });
+    }
     return true;
 }
 

@@ -1,7 +1,9 @@
 // The merging side of a sort larger than memory: the sorted runs (RunSpiller) read back
 // through one buffer each and merged into a single stream in Morton order. Ties go to the
 // earlier run, and runs hold the input in order, so the stream is the stable Morton order of
-// the whole input: point for point what the in-memory sorter emits.
+// the whole input: point for point what the in-memory sorter emits. While a run's buffer is
+// merged, its next buffer's bytes are read ahead into the page cache on a helper thread, so a
+// refill rarely waits for the disk.
 #pragma once
 
 #include "points/morton.hpp"
@@ -10,6 +12,7 @@
 #include "sort/run_spiller.hpp"
 
 #include <cstdint>
+#include <future>
 #include <vector>
 
 namespace omicron {
@@ -45,6 +48,8 @@ private:
     std::vector<Cursor> m_cursors;
     std::vector<std::uint32_t> m_heap; // cursor indices, smallest (code, run) on top
     std::uint64_t m_pointsLeft = 0;
+    // The read-ahead of the last refilled run's next buffer. Last: destroyed first, waiting.
+    std::future<void> m_readAhead;
 };
 
 } // namespace omicron

@@ -2,7 +2,9 @@
 
 #include "io/atomic_file_writer.hpp"
 #include "memory_budget.hpp"
+#include "points/huge_page_buffer.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -101,6 +103,15 @@ void ScratchFile::read(std::uint64_t offset, void* data, std::size_t count) cons
         bytes += got;
         count -= static_cast<std::size_t>(got);
         offset += static_cast<std::uint64_t>(got);
+    }
+}
+
+void ScratchFile::willRead(std::uint64_t offset, std::uint64_t count) const {
+    const std::uint64_t end = std::min(offset + count, m_size);
+    for (std::uint64_t at = offset; at < end; at += kReadAheadChunkBytes) {
+        const std::uint64_t length = std::min<std::uint64_t>(kReadAheadChunkBytes, end - at);
+        posix_fadvise(m_fd, static_cast<off_t>(at), static_cast<off_t>(length),
+                      POSIX_FADV_WILLNEED); // advice: a refusal only costs the read-ahead
     }
 }
 
