@@ -63,6 +63,8 @@ public:
                                  piece.last, out);
                 out += std::size_t{piece.last - piece.first} * m_layout.bytes;
             }
+            m_cloud.keepWithinBudget(); // as the estimation does, per block
+
         });
         for (std::size_t i = 0; i < m_used; ++i) {
             const Block& block = m_blocks[i];
@@ -220,6 +222,9 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
         tbb::parallel_for(std::size_t{0}, batch.nodes.size(), [&](std::size_t b) {
             const auto [level, index] = batch.nodes[b];
             hierarchy.nodeSplats(hierarchy.node(level, index), batch.splats[b], scratch.local());
+            // Over a scratch-file cloud read ahead, faults find the page cache and map pages
+            // faster than the governor's thread, which may wait for a core, can drop them.
+            cloud.keepWithinBudget();
         });
         if (afterRead) { // the batch's pages are in memory: the estimation read them
             afterRead(coveredEnd(hierarchy.node(firstLevel, end - 1)));

@@ -83,6 +83,7 @@ private:
         tbb::parallel_for(begin, end, [&](std::size_t i) {
             m_hierarchy.nodeSplats(m_hierarchy.node(level, i), m_batch[i - begin],
                                    m_scratch.local());
+            cloud.keepWithinBudget(); // faults may outrun the governor's thread
         });
     }
 
@@ -282,10 +283,14 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
     const SubtreePoints subtrees = subtreeHeldPoints(hierarchy);
     const int firstSweptLevel = omhSweepFirstLevel(subtrees, sweepBatch);
     // Over a scratch file, the top levels' points are copied out as the sweep reads the file,
-    // and the top levels are written after it, at their offsets.
+    // and the top levels are written after it, at their offsets. The copy may take a quarter
+    // of the budget (a billion points under 1 GiB need 230 MB): reading the top levels in place
+    // instead touches points spread over the whole file, and each touch maps a page-cache
+    // folio of up to 2 MiB, faster than the governor drops them (1 GiB budget: 1.9-2.5 GB
+    // resident for moments).
     const std::unique_ptr<TopLevelPoints> top =
         options.gatherTopLevels && cloud.fileBacked() && firstSweptLevel > 0
-            ? TopLevelPoints::plan(hierarchy, firstSweptLevel, cloud.residentBudget() / 8)
+            ? TopLevelPoints::plan(hierarchy, firstSweptLevel, cloud.residentBudget() / 4)
             : nullptr;
     const omh::LevelEntry& deepest = header.levels.back();
     const std::uint64_t payloadEnd = deepest.payloadOffset + deepest.points * layout.bytes;

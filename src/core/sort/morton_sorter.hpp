@@ -78,7 +78,7 @@ public:
     // True when this sort spills runs to disk (its in-memory sort exceeds the budget).
     bool spills() const { return m_spiller != nullptr; }
     // Runs written so far (0 for an in-memory sort).
-    std::size_t runCount() const { return m_spiller ? m_spiller->runs().size() : 0; }
+    std::size_t runCount() const { return m_spiller ? m_spiller->runsWritten() : 0; }
 
     // Reading phase (one thread): appends a batch in the unit cube of info.cube.
     void add(const PointBatch& batch);

@@ -79,6 +79,7 @@ void RunSpiller::finish() {
 void RunSpiller::collectSpill() {
     if (m_spilling.valid()) {
         m_runs.push_back(m_spilling.get());
+        m_runsWritten.store(m_runs.size(), std::memory_order_relaxed);
     }
 }
 

@@ -14,6 +14,7 @@
 #include "points/point_records.hpp"
 #include "sort/scratch_folder.hpp"
 
+#include <atomic>
 #include <cstdint>
 #include <future>
 #include <memory>
@@ -50,6 +51,8 @@ public:
     // The runs written so far (the one being written is not among them until the next spill
     // or finish()). Reading thread only.
     const std::vector<SortedRun>& runs() const { return m_runs; }
+    // How many runs() holds, for any thread (progress).
+    std::size_t runsWritten() const { return m_runsWritten.load(std::memory_order_relaxed); }
     AttributeSet attributes() const { return m_buffer.attributes; }
     std::size_t runPoints() const { return m_runPoints; }
     const ScratchFolder& folder() const { return m_folder; }
@@ -72,6 +75,7 @@ private:
     std::vector<morton::Code> m_spilledCodes;
     std::size_t m_runsStarted = 0;
     std::vector<SortedRun> m_runs;
+    std::atomic<std::size_t> m_runsWritten{0};
     // Last: destroyed first, waiting for a run still being written (the reader threw).
     std::future<SortedRun> m_spilling;
 };

@@ -254,7 +254,10 @@ TEST(ExternalSortCleanup, AReaderFailureMidwayRemovesTheRuns) {
                      [&](const IncrementalMortonSorter& ready) { sorter = &ready; }),
                  InputError);
     EXPECT_GT(runsWhenFailing, 1u);
-    EXPECT_EQ(entriesWhenFailing, runsWhenFailing) << "one file per run";
+    // One file per run written, and one more for a run being written on the spilling thread
+    // (the sorter's thread may start another between the two looks).
+    EXPECT_GE(entriesWhenFailing, runsWhenFailing) << "one file per run";
+    EXPECT_LE(entriesWhenFailing, runsWhenFailing + 2) << "one file per run";
     EXPECT_EQ(entriesIn(scratch.path()), 0u);
 }
 
