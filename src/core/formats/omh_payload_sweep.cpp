@@ -64,7 +64,6 @@ public:
                 out += std::size_t{piece.last - piece.first} * m_layout.bytes;
             }
             m_cloud.keepWithinBudget(); // as the estimation does, per block
-
         });
         for (std::size_t i = 0; i < m_used; ++i) {
             const Block& block = m_blocks[i];

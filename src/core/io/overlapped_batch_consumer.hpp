@@ -36,7 +36,8 @@ public:
     OverlappedBatchConsumer& operator=(const OverlappedBatchConsumer&) = delete;
 
     // Reader thread: copies `batch` for the worker and codes its points, waiting while the
-    // worker still has the previous copy. Rethrows what the consumer threw (its later batches are not consumed).
+    // worker still has the previous copy. Rethrows what the consumer threw (its later batches
+    // are not consumed).
     void push(const PointBatch& batch);
     // Reader thread, after the last push: waits until every batch is consumed; rethrows what
     // the consumer threw.

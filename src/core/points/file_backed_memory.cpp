@@ -1,6 +1,7 @@
 // The scratch-file mappings of points/huge_page_buffer.hpp (FileBacking).
 #include "points/huge_page_buffer.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fcntl.h>
@@ -67,6 +68,17 @@ void writeScratchFile(int fd, std::uint64_t offset, const void* data, std::size_
         from += written;
         offset += static_cast<std::uint64_t>(written);
         bytes -= static_cast<std::size_t>(written);
+    }
+}
+
+void readFileAhead(int fd, std::uint64_t offset, std::uint64_t bytes) {
+    constexpr std::uint64_t kHintBytes = std::uint64_t{1} << 20; // under any device's window
+    const std::uint64_t end = offset + bytes;
+    for (std::uint64_t at = offset; at < end; at += kHintBytes) {
+        const std::uint64_t length = std::min(kHintBytes, end - at);
+        // Advice: a refusal only costs the read-ahead.
+        posix_fadvise(fd, static_cast<off_t>(at), static_cast<off_t>(length),
+                      POSIX_FADV_WILLNEED);
     }
 }
 

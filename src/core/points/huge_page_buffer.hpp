@@ -30,9 +30,6 @@
 namespace omicron {
 
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
-// Bytes per read-ahead hint to the kernel (HugePageArray::willRead): at most what it reads per
-// hint on common devices (its window is the larger of read_ahead_kb and the largest request).
-inline constexpr std::uintptr_t kReadAheadChunkBytes = std::uintptr_t{1} << 20;
 
 // The bytes an array of `bytes` takes: a whole number of huge pages.
 constexpr std::size_t hugePageArrayBytes(std::size_t bytes) {
@@ -60,6 +57,14 @@ void unmapScratchFile(void* memory, std::size_t bytes, int fd);
 // Writes `bytes` at `offset` of the scratch file with `fd` through the page cache; the
 // mapping sees them at once. Throws std::runtime_error (an I/O error: the space is reserved).
 void writeScratchFile(int fd, std::uint64_t offset, const void* data, std::size_t bytes);
+// Bytes [offset, offset + bytes) of the file with `fd` will be read soon: the kernel reads them
+// into the page cache (nothing is mapped: the resident set does not grow). It reads at most its
+// read-ahead window per hint (read_ahead_kb, or the device's largest request) and silently
+// drops the rest, so this gives one hint per MiB: one hint for a batch of hundreds of MB read
+// 8 MB of it, and a save beyond the budget then waited on a fault per window (85 MB/s from a
+// disk that reads 1.4 GB/s). The kernel submits the reads as it goes, waiting when the
+// device's queue is full: call it from a thread that has nothing else to do.
+void readFileAhead(int fd, std::uint64_t offset, std::uint64_t bytes);
 // Gives the pages of [memory, memory + bytes) back (file-backed: their data stays in the
 // file and the page cache).
 void dropResidentPages(void* memory, std::size_t bytes);
@@ -146,23 +151,12 @@ public:
     operator std::span<const T>() const { return {m_data.get(), m_size}; }
 
     bool fileBacked() const { return m_mappedBytes != 0; }
-    // File-backed only: elements [begin, end) will be read soon; the kernel reads them into
-    // the page cache (they are not mapped: the resident set does not grow). One hint per
-    // kReadAheadChunkBytes: the kernel reads at most its read-ahead window (read_ahead_kb, or
-    // the device's largest request) per hint and silently drops the rest, so one hint for a
-    // batch of hundreds of MB read 8 MB of it and the save then waited on a fault per window
-    // (measured beyond the budget: 85 MB/s from a disk that reads 1.4 GB/s). The kernel
-    // submits the reads as it goes, waiting when the device's queue is full: call it from a
-    // thread that has nothing else to do.
+    // File-backed only: elements [begin, end) will be read soon (readFileAhead; the mapping
+    // starts at the file's first byte).
     void willRead(std::size_t begin, std::size_t end) const {
+        end = std::min(end, m_size);
         if (m_mappedBytes != 0 && begin < end) {
-            const std::uintptr_t base = reinterpret_cast<std::uintptr_t>(m_data.get());
-            const std::uintptr_t first = (base + begin * sizeof(T)) & ~std::uintptr_t{4095};
-            const std::uintptr_t last = base + std::min(end, m_size) * sizeof(T);
-            for (std::uintptr_t at = first; at < last; at += kReadAheadChunkBytes) {
-                const std::uintptr_t length = std::min<std::uintptr_t>(kReadAheadChunkBytes, last - at);
-                madvise(reinterpret_cast<void*>(at), length, MADV_WILLNEED);
-            }
+            readFileAhead(m_data.get_deleter().fd, begin * sizeof(T), (end - begin) * sizeof(T));
         }
     }
     // File-backed only: stores `values` at elements [first, first + values.size()) with a

@@ -107,11 +107,8 @@ void ScratchFile::read(std::uint64_t offset, void* data, std::size_t count) cons
 }
 
 void ScratchFile::willRead(std::uint64_t offset, std::uint64_t count) const {
-    const std::uint64_t end = std::min(offset + count, m_size);
-    for (std::uint64_t at = offset; at < end; at += kReadAheadChunkBytes) {
-        const std::uint64_t length = std::min<std::uint64_t>(kReadAheadChunkBytes, end - at);
-        posix_fadvise(m_fd, static_cast<off_t>(at), static_cast<off_t>(length),
-                      POSIX_FADV_WILLNEED); // advice: a refusal only costs the read-ahead
+    if (offset < m_size) {
+        readFileAhead(m_fd, offset, std::min(count, m_size - offset));
     }
 }
 

@@ -55,9 +55,8 @@ public:
     void write(const void* data, std::size_t count); // appends; throws OutputError
     // Reads exactly `count` bytes at `offset`; throws std::runtime_error naming the file.
     void read(std::uint64_t offset, void* data, std::size_t count) const;
-    // Bytes [offset, offset + count) will be read soon: the kernel reads them into the page
-    // cache (a hint per kReadAheadChunkBytes, see HugePageArray::willRead; it may wait while
-    // the device's queue is full, so call it from a thread that has nothing else to do).
+    // Bytes [offset, offset + count) will be read soon (readFileAhead: call it from a thread
+    // that has nothing else to do).
     void willRead(std::uint64_t offset, std::uint64_t count) const;
     std::uint64_t size() const { return m_size; }
     const std::string& path() const { return m_path; }
