@@ -5,19 +5,28 @@
 
 namespace omicron {
 
-std::unique_ptr<TopLevelPoints> TopLevelPoints::plan(const Hierarchy& hierarchy, int levels,
-                                                     std::uint64_t maxBytes) {
-    const SortedCloud& source = hierarchy.cloud();
-    const AttributeSet attributes = source.attributes();
+namespace {
+
+std::uint64_t heldPoints(const Hierarchy& hierarchy, int levels) {
     std::uint64_t held = 0;
     for (int level = 0; level < levels; ++level) {
         for (std::size_t i = 0; i < hierarchy.nodeCount(level); ++i) {
             held += hierarchy.node(level, i).pointCount;
         }
     }
-    if (held * (pointBytes(attributes) + 2 * sizeof(std::uint32_t)) > maxBytes) {
-        return nullptr;
-    }
+    return held;
+}
+
+} // namespace
+
+std::uint64_t TopLevelPoints::bytesFor(const Hierarchy& hierarchy, int levels) {
+    return heldPoints(hierarchy, levels) *
+           (pointBytes(hierarchy.cloud().attributes()) + 2 * sizeof(std::uint32_t));
+}
+
+std::unique_ptr<TopLevelPoints> TopLevelPoints::plan(const Hierarchy& hierarchy, int levels) {
+    const SortedCloud& source = hierarchy.cloud();
+    const std::uint64_t held = heldPoints(hierarchy, levels);
 
     // Which points to gather: every level's held points (a level's are ascending, since its
     // nodes are in Morton order), merged without repeats.
@@ -51,7 +60,7 @@ std::unique_ptr<TopLevelPoints> TopLevelPoints::plan(const Hierarchy& hierarchy,
         }
     }
 
-    top->m_cloud = std::make_shared<SortedCloud>(source.cube(), source.sourceOffset(), attributes,
+    top->m_cloud = std::make_shared<SortedCloud>(source.cube(), source.sourceOffset(), source.attributes(),
                                                  points.size());
     top->m_points = std::move(points);
     return top;

@@ -22,11 +22,13 @@ namespace omicron {
 
 class TopLevelPoints {
 public:
+    // Bytes the copy of levels [0, levels) of `hierarchy` takes at most: their held points
+    // (a point held by several levels counts once per level) and their renumbered indices.
+    static std::uint64_t bytesFor(const Hierarchy& hierarchy, int levels);
+
     // Plans the copy of the held points of levels [0, levels) of `hierarchy` (complete, over a
-    // file-backed cloud), or returns nullptr when they would take more than `maxBytes` in
-    // memory (then read them in place). Copies nothing yet.
-    static std::unique_ptr<TopLevelPoints> plan(const Hierarchy& hierarchy, int levels,
-                                                std::uint64_t maxBytes);
+    // file-backed cloud). Copies nothing yet.
+    static std::unique_ptr<TopLevelPoints> plan(const Hierarchy& hierarchy, int levels);
 
     // Copies the planned points below cloud index `end` not copied yet; calls come with
     // growing `end`, typically as each stretch of the source is in memory.

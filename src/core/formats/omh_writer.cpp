@@ -278,19 +278,30 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
             ? std::max(std::clamp<std::uint64_t>(budgetPoints / 8, 1, kSweepBatchPoints),
                        std::min(budgetPoints / 32, kFileBackedSweepBatchPoints))
             : kInMemorySweepBatchPoints;
-    const std::uint64_t sweepBatch =
+    std::uint64_t sweepBatch =
         options.sweepBatchPoints > 0 ? options.sweepBatchPoints : defaultBatch;
     const SubtreePoints subtrees = subtreeHeldPoints(hierarchy);
-    const int firstSweptLevel = omhSweepFirstLevel(subtrees, sweepBatch);
+    int firstSweptLevel = omhSweepFirstLevel(subtrees, sweepBatch);
     // Over a scratch file, the top levels' points are copied out as the sweep reads the file,
-    // and the top levels are written after it, at their offsets. The copy may take a quarter
-    // of the budget (a billion points under 1 GiB need 230 MB): reading the top levels in place
-    // instead touches points spread over the whole file, and each touch maps a page-cache
-    // folio of up to 2 MiB, faster than the governor drops them (1 GiB budget: 1.9-2.5 GB
-    // resident for moments).
+    // and the top levels are written after it, at their offsets. Read in place instead, they
+    // touch points spread over the whole file, and each touch maps a page-cache folio of up to
+    // 2 MiB, faster than the governor drops them: a billion points held 1.9-2.5 GB for moments
+    // under 1G, 2.5 GB under 256M. The copy is held beside the budget, so where it would take
+    // more than a quarter of it, bigger batches leave fewer levels above the sweep, up to
+    // batches whose splat attributes (6 bytes a point, two batches in flight) take a quarter
+    // of the budget: a billion points under 256M copy 230 MB instead of 1.1 GB.
+    if (options.gatherTopLevels && cloud.fileBacked() && options.sweepBatchPoints == 0) {
+        const std::uint64_t quarter = cloud.residentBudget() / 4;
+        const std::uint64_t largestBatch = std::max(sweepBatch, quarter / 12);
+        while (firstSweptLevel > 0 && sweepBatch < largestBatch &&
+               TopLevelPoints::bytesFor(hierarchy, firstSweptLevel) > quarter) {
+            sweepBatch = std::min(sweepBatch * 2, largestBatch);
+            firstSweptLevel = omhSweepFirstLevel(subtrees, sweepBatch);
+        }
+    }
     const std::unique_ptr<TopLevelPoints> top =
         options.gatherTopLevels && cloud.fileBacked() && firstSweptLevel > 0
-            ? TopLevelPoints::plan(hierarchy, firstSweptLevel, cloud.residentBudget() / 4)
+            ? TopLevelPoints::plan(hierarchy, firstSweptLevel)
             : nullptr;
     const omh::LevelEntry& deepest = header.levels.back();
     const std::uint64_t payloadEnd = deepest.payloadOffset + deepest.points * layout.bytes;

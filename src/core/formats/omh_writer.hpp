@@ -20,7 +20,8 @@ struct OmhWriteOptions {
     std::function<void(int level)> afterLevel;
     // Points held by a batch of the one-pass sweep that writes the deep levels (0: the
     // default, 1 Mi; for a cloud in a scratch file at most an eighth of the budget's worth, or a
-    // 32nd of it when that is more). The bytes written do not depend on it; tests vary it.
+    // 32nd of it when that is more, and bigger where the top levels' copy needs it). The bytes
+    // written do not depend on it; tests vary it.
     std::uint64_t sweepBatchPoints = 0;
     // Over a cloud in a scratch file, copy the top levels' points out while the sweep reads
     // the file and write them afterwards (omh_top_levels.hpp) rather than read them in place.

@@ -147,10 +147,10 @@ TEST(BudgetedBuild, ASortedStreamBeyondTheBudgetStreamsIntoAFileBackedCloud) {
 }
 
 // A save over a cloud in a scratch file writes the in-memory build's bytes, whether the top
-// levels' points are copied out while the sweep reads the file or read in place, for sweep
-// batches from one point (every level but the deepest above the sweep) to the whole
-// hierarchy, and with leaves collapsed (a collapsed leaf's points lie under no swept subtree:
-// they are copied between two batches' stretches).
+// levels' points are copied out while the sweep reads the file (whatever their size) or read
+// in place, for sweep batches from one point (every level but the deepest above the sweep) to
+// the whole hierarchy, and with leaves collapsed (a collapsed leaf's points lie under no swept
+// subtree: they are copied between two batches' stretches).
 TEST(BudgetedBuild, SaveOverTheScratchFileWritesTheInMemoryBytes) {
     OMICRON_REQUIRE_SHARED_FILE(path, "lion.ply");
     test::TempDir scratch;
@@ -180,6 +180,13 @@ TEST(BudgetedBuild, SaveOverTheScratchFileWritesTheInMemoryBytes) {
                 writeOmh(scratch.file("budgeted.omh"), *budgeted.hierarchy(), info, write);
                 EXPECT_EQ(test::readBytes(scratch.file("budgeted.omh")),
                           test::readBytes(reference));
+                if (gather && batch == 1) {
+                    // Every parent is above the sweep: their points are a quarter of the
+                    // cloud, far beyond a quarter of the 4 MiB budget, and are still copied
+                    // (written after the swept deepest level), never read in place.
+                    ASSERT_FALSE(levelsWritten.empty());
+                    EXPECT_EQ(levelsWritten.front(), 7);
+                }
                 std::sort(levelsWritten.begin(), levelsWritten.end());
                 EXPECT_EQ(levelsWritten, (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));
             }
