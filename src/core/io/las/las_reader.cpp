@@ -219,13 +219,21 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
     const bool hasColor = m_colorDepth != ColorDepth::None;
     const std::size_t stride = m_header.recordLength;
     const LasColumnLayout lasLayout = LasColumnLayout::of(m_info.attributes);
-    std::vector<std::uint8_t> column(lasLayout.bytes);
+    // The LAS column is sized for a whole batch up front and each point's bytes are written in
+    // place: appending them point by point cost a library call each (3 % of a LAS build's CPU
+    // time, on the reading thread the whole pipeline waits for).
+    const std::size_t lasBytes = lasLayout.bytes;
+    const std::size_t batchCapacity =
+        static_cast<std::size_t>(std::min<std::uint64_t>(batchPoints, m_header.pointCount));
+    batch.las.resize(batchCapacity * lasBytes);
 
     const auto deliver = [&] {
+        batch.las.resize(batch.size() * lasBytes);
         consumer(batch);
         ++summary.batches;
         summary.pointsDelivered += batch.size();
         batch.clear();
+        batch.las.resize(batchCapacity * lasBytes);
     };
     m_records->forEachBlock([&](const LasRecordBlock& block) {
         for (std::uint64_t i = 0; i < block.count; ++i) {
@@ -240,10 +248,8 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
             if (hasColor) {
                 batch.colors.push_back(color(record));
             }
-            // Assembled on the stack, appended without zero-filling (the capacity is reserved).
-            las::readLasColumn(record, m_header.pointFormat, lasLayout, column.data());
-            batch.las.insert(batch.las.end(), column.begin(),
-                             column.begin() + static_cast<std::ptrdiff_t>(lasLayout.bytes));
+            las::readLasColumn(record, m_header.pointFormat, lasLayout,
+                               batch.las.data() + (batch.positions.size() - 1) * lasBytes);
             if (batch.size() == batchPoints) {
                 deliver();
                 const bool morePoints = block.firstIndex + i + 1 < m_header.pointCount;
