@@ -108,6 +108,20 @@ inline void releasePages(const void* memory, std::size_t bytes) {
     adviseWholePages(memory, bytes, kSmallPageBytes, MADV_DONTNEED);
 }
 
+// Faults in, writable, the small pages that hold [memory, memory + bytes) of an anonymous
+// buffer, in one call: for a range about to be filled by a bulk copy, which costs a quarter more
+// when it faults page by page (bench/page_cost_bench: populated against anonymous). Advice
+// only: a kernel without MADV_POPULATE_WRITE (before 5.14) leaves the faults to the copy.
+inline void populatePages(const void* memory, std::size_t bytes) {
+    if (bytes == 0) {
+        return;
+    }
+    const auto begin = reinterpret_cast<std::uintptr_t>(memory) & ~(kSmallPageBytes - 1);
+    const auto end = (reinterpret_cast<std::uintptr_t>(memory) + bytes + kSmallPageBytes - 1) &
+                     ~(kSmallPageBytes - 1);
+    madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
+}
+
 template <typename T> class HugePageArray {
     static_assert(std::is_trivially_copyable_v<T>, "elements are left uninitialised");
 

@@ -169,6 +169,16 @@ void IncrementalMortonSorter::add(const PointBatch& batch, std::span<const morto
         std::uint16_t& lastBin = m_blockLastBin[(firstIndex + i) >> kReleaseBlockBits];
         lastBin = std::max(lastBin, binIndex);
     }
+    // The arrival arrays are reserved for the whole cloud and filled batch by batch: each
+    // batch's new pages are faulted in by one call per array before the copy.
+    const auto populate = [&](const auto& to, const auto& from) {
+        populatePages(to.data() + to.size(), from.size() * sizeof(from[0]));
+    };
+    populate(m_input.positions, batch.positions);
+    populate(m_input.normals, batch.normals);
+    populate(m_input.colors, batch.colors);
+    populate(m_input.intensities, batch.intensities);
+    populate(m_input.las, batch.las);
     m_input.append(batch);
 }
 
