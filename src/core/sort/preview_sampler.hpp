@@ -1,6 +1,6 @@
 // The first pixels of pipeline 1: a uniform random sample of the points read so far
-// (reservoir sampling with a fixed hash, so the same input gives the same sample on every
-// machine), taken while the sorter reads, readable from any thread.
+// (reservoir sampling driven by a fixed hash, so the same input gives the same sample on every
+// run), taken while the sorter reads, readable from any thread.
 #pragma once
 
 #include "points/point_batch.hpp"
@@ -32,8 +32,19 @@ public:
     PreviewSample sample() const;
 
 private:
+    // The next uniform draw in (0, 1), and in [0, n).
+    double uniform();
+    std::size_t uniformBelow(std::size_t n);
+    // Moves m_next to the next point the reservoir takes.
+    void skip();
+
     std::size_t m_capacity;
     std::uint64_t m_seed;
+    std::uint64_t m_draws = 0;
+    // Once the reservoir is full: the index of the next point it takes, and Algorithm L's W.
+    bool m_full = false;
+    std::uint64_t m_next = 0;
+    double m_w = 1.0;
     mutable std::mutex m_mutex;
     PreviewSample m_sample;
 };
