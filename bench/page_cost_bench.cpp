@@ -14,9 +14,6 @@
 //        bench=page_cost summary fresh_anonymous_s_per_gb= fresh_file_s_per_gb= ...
 #include "bench_timing.hpp"
 
-#include <sys/mman.h>
-#include <sys/resource.h>
-
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
@@ -24,6 +21,8 @@
 #include <cstring>
 #include <fcntl.h>
 #include <string>
+#include <sys/mman.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 namespace {
@@ -80,8 +79,7 @@ Figure fillFresh(const std::uint8_t* source, std::size_t bytes, bool populate) {
 
 void writeAll(int fd, const std::uint8_t* data, std::size_t bytes, const std::string& path) {
     for (std::size_t done = 0; done < bytes;) {
-        const ssize_t written =
-            pwrite(fd, data + done, bytes - done, static_cast<off_t>(done));
+        const ssize_t written = pwrite(fd, data + done, bytes - done, static_cast<off_t>(done));
         if (written < 0 && errno == EINTR) {
             continue;
         }
@@ -166,8 +164,8 @@ int main(int argc, char** argv) {
                 "rewritten_s_per_gb=%.3f fresh_vs_rewritten=%.1f fresh_file_s_per_gb=%.3f "
                 "file_again_s_per_gb=%.3f file_new_vs_again=%.1f\n",
                 mib, dir.c_str(), anonymous.seconds / gb, rewritten.seconds / gb,
-                anonymous.seconds / rewritten.seconds, fileNew.seconds / gb,
-                fileAgain.seconds / gb, fileNew.seconds / fileAgain.seconds);
+                anonymous.seconds / rewritten.seconds, fileNew.seconds / gb, fileAgain.seconds / gb,
+                fileNew.seconds / fileAgain.seconds);
     munmap(source, bytes);
     return 0;
 }

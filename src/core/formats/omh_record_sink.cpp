@@ -54,10 +54,6 @@ void encodeRecord(const SortedCloud& cloud, const omh::RecordLayout& layout, std
     }
 }
 
-} // namespace
-
-namespace {
-
 // encodeRecord's work over the exact store's arrays, with the LAS column's width known at
 // compile time (0: read from the layout), so its copy is a few moves rather than a library call
 // per record, as in the sorter's gather.

@@ -60,8 +60,8 @@ std::unique_ptr<TopLevelPoints> TopLevelPoints::plan(const Hierarchy& hierarchy,
         }
     }
 
-    top->m_cloud = std::make_shared<SortedCloud>(source.cube(), source.sourceOffset(), source.attributes(),
-                                                 points.size());
+    top->m_cloud = std::make_shared<SortedCloud>(source.cube(), source.sourceOffset(),
+                                                 source.attributes(), points.size());
     top->m_points = std::move(points);
     return top;
 }

@@ -1,10 +1,9 @@
 // The preview's reservoir: a uniform sample of everything added, the same whatever the batches.
 #include "sort/preview_sampler.hpp"
 
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <array>
+#include <gtest/gtest.h>
 #include <set>
 
 namespace omicron {
