@@ -31,6 +31,10 @@ OmhRecordSink::OmhRecordSink(AtomicFileWriter& file, const SortedCloud& cloud,
 
 namespace {
 
+// One point record. `LasBytes` is the LAS column's width when known at compile time (0: read
+// from the layout), so that the column's copy is a few moves rather than a library call per
+// record (as in the sorter's gather).
+template <std::size_t LasBytes = 0>
 void encodeRecord(const SortedCloud& cloud, const omh::RecordLayout& layout, std::uint32_t index,
                   std::uint16_t encodedRadius, std::uint32_t estimatedNormal,
                   std::uint8_t* record) {
@@ -45,8 +49,9 @@ void encodeRecord(const SortedCloud& cloud, const omh::RecordLayout& layout, std
     if (attributes.has(Attribute::Intensity)) {
         storeRaw(record + layout.point.intensityOffset, cloud.intensities()[index]);
     }
-    if (layout.point.lasBytes != 0) { // no LAS column: no record to copy from
-        std::memcpy(record + layout.point.lasOffset, cloud.lasRecord(index), layout.point.lasBytes);
+    const std::size_t lasBytes = LasBytes != 0 ? LasBytes : layout.point.lasBytes;
+    if (lasBytes != 0) { // no LAS column: no record to copy from
+        std::memcpy(record + layout.point.lasOffset, cloud.lasRecord(index), lasBytes);
     }
     storeRaw(record + layout.radiusOffset, encodedRadius);
     if (layout.estimatedNormalOffset != 0) {
@@ -54,40 +59,13 @@ void encodeRecord(const SortedCloud& cloud, const omh::RecordLayout& layout, std
     }
 }
 
-// encodeRecord's work over the exact store's arrays, with the LAS column's width known at
-// compile time (0: read from the layout), so its copy is a few moves rather than a library call
-// per record, as in the sorter's gather.
 template <std::size_t LasBytes>
-void encodeExactRecords(const SortedCloud& cloud, const omh::RecordLayout& layout,
-                        const OctreeNode& node, const NodeSplats& splats, std::uint32_t first,
-                        std::uint32_t last, std::uint8_t* out) {
-    const std::span<const glm::vec3> positions = cloud.positions();
-    const std::span<const glm::vec3> normals = cloud.normals();
-    const std::span<const glm::u8vec3> colors = cloud.colors();
-    const std::span<const std::uint16_t> intensities = cloud.intensities();
-    const std::uint8_t* las = cloud.lasColumn().data();
-    const std::size_t lasBytes = LasBytes != 0 ? LasBytes : layout.point.lasBytes;
-    const oms::RecordLayout& point = layout.point;
+void encodeRecords(const SortedCloud& cloud, const omh::RecordLayout& layout,
+                   const OctreeNode& node, const NodeSplats& splats, std::uint32_t first,
+                   std::uint32_t last, std::uint8_t* out) {
     for (std::uint32_t p = first; p < last; ++p, out += layout.bytes) {
-        const std::uint32_t index = node.heldPoint(p);
-        storeRaw(out, positions[index]);
-        if (!normals.empty()) {
-            storeRaw(out + point.normalOffset, normals[index]);
-        }
-        if (!colors.empty()) {
-            storeRaw(out + point.colorOffset, colors[index]);
-        }
-        if (!intensities.empty()) {
-            storeRaw(out + point.intensityOffset, intensities[index]);
-        }
-        if (lasBytes != 0) {
-            std::memcpy(out + point.lasOffset, las + std::size_t{index} * lasBytes, lasBytes);
-        }
-        storeRaw(out + layout.radiusOffset, splats.radii[p]);
-        if (layout.estimatedNormalOffset != 0) {
-            storeRaw(out + layout.estimatedNormalOffset,
-                     splats.normals.empty() ? 0u : splats.normals[p]);
-        }
+        encodeRecord<LasBytes>(cloud, layout, node.heldPoint(p), splats.radii[p],
+                               splats.normals.empty() ? 0u : splats.normals[p], out);
     }
 }
 
@@ -96,21 +74,15 @@ void encodeExactRecords(const SortedCloud& cloud, const omh::RecordLayout& layou
 void encodeOmhRecords(const SortedCloud& cloud, const omh::RecordLayout& layout,
                       const OctreeNode& node, const NodeSplats& splats, std::uint32_t first,
                       std::uint32_t last, std::uint8_t* out) {
-    if (cloud.storage() == PointStorage::Exact) {
-        switch (layout.point.lasBytes) { // the LAS column of formats 0/2, 1/3-7/9 and 8/10
-        case 8:
-            return encodeExactRecords<8>(cloud, layout, node, splats, first, last, out);
-        case 16:
-            return encodeExactRecords<16>(cloud, layout, node, splats, first, last, out);
-        case 18:
-            return encodeExactRecords<18>(cloud, layout, node, splats, first, last, out);
-        default:
-            return encodeExactRecords<0>(cloud, layout, node, splats, first, last, out);
-        }
-    }
-    for (std::uint32_t p = first; p < last; ++p, out += layout.bytes) {
-        encodeRecord(cloud, layout, node.heldPoint(p), splats.radii[p],
-                     splats.normals.empty() ? 0u : splats.normals[p], out);
+    switch (layout.point.lasBytes) { // the LAS column of formats 0/2, 1/3-7/9 and 8/10
+    case 8:
+        return encodeRecords<8>(cloud, layout, node, splats, first, last, out);
+    case 16:
+        return encodeRecords<16>(cloud, layout, node, splats, first, last, out);
+    case 18:
+        return encodeRecords<18>(cloud, layout, node, splats, first, last, out);
+    default:
+        return encodeRecords<0>(cloud, layout, node, splats, first, last, out);
     }
 }
 

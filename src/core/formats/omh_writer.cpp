@@ -290,7 +290,8 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
     // more than a quarter of it, bigger batches leave fewer levels above the sweep, up to
     // batches whose splat attributes (6 bytes a point, two batches in flight) take a quarter
     // of the budget: a billion points under 256M copy 230 MB instead of 1.1 GB.
-    if (options.gatherTopLevels && cloud.fileBacked() && options.sweepBatchPoints == 0) {
+    const bool gather = options.gatherTopLevels && cloud.fileBacked();
+    if (gather && options.sweepBatchPoints == 0) {
         const std::uint64_t quarter = cloud.residentBudget() / 4;
         const std::uint64_t largestBatch = std::max(sweepBatch, quarter / 12);
         while (firstSweptLevel > 0 && sweepBatch < largestBatch &&
@@ -300,9 +301,7 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
         }
     }
     const std::unique_ptr<TopLevelPoints> top =
-        options.gatherTopLevels && cloud.fileBacked() && firstSweptLevel > 0
-            ? TopLevelPoints::plan(hierarchy, firstSweptLevel)
-            : nullptr;
+        gather && firstSweptLevel > 0 ? TopLevelPoints::plan(hierarchy, firstSweptLevel) : nullptr;
     const omh::LevelEntry& deepest = header.levels.back();
     const std::uint64_t payloadEnd = deepest.payloadOffset + deepest.points * layout.bytes;
     if (top) {

@@ -56,8 +56,11 @@ void PreviewSampler::add(const PointBatch& batch, std::uint64_t firstIndex) {
             m_sample.colors.push_back(batch.colors[index - firstIndex]);
         }
     }
-    if (!m_full && index == m_capacity) {
-        m_full = true;
+    if (index < m_capacity) {
+        m_sample.pointsSeen = end; // still filling
+        return;
+    }
+    if (firstIndex < m_capacity) { // this batch filled it
         m_w = std::exp(std::log(uniform()) / static_cast<double>(m_capacity));
         m_next = m_capacity - 1;
         skip();
@@ -66,7 +69,7 @@ void PreviewSampler::add(const PointBatch& batch, std::uint64_t firstIndex) {
     // from one taken point to the next costs a few draws per taken point (about
     // capacity * ln(points / capacity) of them) instead of a hash per point read, which was
     // 2 % of a LAS build's CPU time, on the sorter's thread that bounds the read phase.
-    while (m_full && m_next < end) {
+    while (m_next < end) {
         const std::size_t i = static_cast<std::size_t>(m_next - firstIndex);
         const std::size_t slot = uniformBelow(m_capacity);
         m_sample.positions[slot] = batch.positions[i];

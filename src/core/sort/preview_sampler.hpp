@@ -42,7 +42,6 @@ private:
     std::uint64_t m_seed;
     std::uint64_t m_draws = 0;
     // Once the reservoir is full: the index of the next point it takes, and Algorithm L's W.
-    bool m_full = false;
     std::uint64_t m_next = 0;
     double m_w = 1.0;
     mutable std::mutex m_mutex;
