@@ -1,6 +1,7 @@
 #include "interrupt.hpp"
 
 #include <chrono>
+#include <condition_variable>
 #include <csignal>
 #include <mutex>
 #include <thread>
@@ -40,14 +41,20 @@ void throwIfInterrupted() {
 PipelineResult runInterruptibly(BuildPipeline& pipeline, const std::string& path,
                                 const PipelineOptions& options) {
     const std::atomic<bool>& interrupted = watchInterrupts();
-    // The pipeline has its own cancel flag; a watcher hands the signal over.
+    // The pipeline has its own cancel flag; a watcher hands the signal over. A signal handler
+    // cannot notify a condition variable, so the flag is polled; the end of the run wakes the
+    // watcher at once (a sleeping watcher held `build --save` up to 20 ms between the
+    // hierarchy's completion and the save, with both cores idle).
     std::jthread watcher([&](std::stop_token stop) {
+        std::mutex mutex;
+        std::condition_variable_any wake;
+        std::unique_lock lock(mutex);
         while (!stop.stop_requested()) {
-            if (interrupted.load(std::memory_order_relaxed)) {
+            if (wake.wait_for(lock, stop, std::chrono::milliseconds(20),
+                              [&] { return interrupted.load(std::memory_order_relaxed); })) {
                 pipeline.cancel();
                 return;
             }
-            std::this_thread::sleep_for(std::chrono::milliseconds(20));
         }
     });
     PipelineResult result = pipeline.run(path, options);
