@@ -65,45 +65,105 @@ AttributeSet attributesOfFormat(std::uint8_t pointFormat, std::uint16_t recordLe
     return attributes;
 }
 
-void readLasColumn(const std::uint8_t* record, std::uint8_t pointFormat,
-                   const LasColumnLayout& layout, std::uint8_t* column) {
-    if (pointFormat <= 5) {
-        // Legacy fields mapped onto LAS 1.4's: 3-bit returns to nibbles, the class byte's flags
-        // to the flags byte, the scan angle rank's whole degrees to 0.006 degree steps (from a
-        // table: no rounding per point).
-        static const std::array<std::int16_t, 256> kRankSteps = [] {
-            std::array<std::int16_t, 256> steps{};
-            for (int byte = 0; byte < 256; ++byte) {
-                steps[static_cast<std::size_t>(byte)] = static_cast<std::int16_t>(
-                    std::lround(static_cast<std::int8_t>(byte) * kScanStepsPerDegree));
-            }
-            return steps;
-        }();
-        const std::uint8_t returns = record[legacy::kReturns];
-        const std::uint8_t classByte = record[legacy::kClass];
-        column[0] = classByte & 0x1f;
-        column[1] = static_cast<std::uint8_t>((returns & 0x07) | ((returns >> 3) & 0x07) << 4);
-        column[2] = static_cast<std::uint8_t>((classByte >> 5) | (returns & 0xc0));
-        column[3] = record[legacy::kUserData];
-        storeRaw(column + 4, kRankSteps[record[legacy::kScanRank]]);
-        std::memcpy(column + 6, record + legacy::kSourceId, 2);
-        if (layout.gpsTimeOffset != 0) {
-            std::memcpy(column + layout.gpsTimeOffset, record + legacy::kGpsTime, 8);
+namespace {
+
+// Whole degrees of a legacy scan angle rank (the byte as stored) in LAS 1.4's 0.006 degree
+// steps, from a table: no rounding per point.
+const std::array<std::int16_t, 256>& rankSteps() {
+    static const std::array<std::int16_t, 256> kRankSteps = [] {
+        std::array<std::int16_t, 256> steps{};
+        for (int byte = 0; byte < 256; ++byte) {
+            steps[static_cast<std::size_t>(byte)] = static_cast<std::int16_t>(
+                std::lround(static_cast<std::int8_t>(byte) * kScanStepsPerDegree));
         }
-    } else {
-        // LAS 1.4's returns and flags bytes are the column's; class and user data follow.
-        column[0] = record[v14::kClass];
-        column[1] = record[v14::kReturns];
-        column[2] = record[v14::kFlags];
-        column[3] = record[v14::kUserData];
-        std::memcpy(column + 4, record + v14::kScanAngle, 4); // scan angle, point source ID
-        std::memcpy(column + layout.gpsTimeOffset, record + v14::kGpsTime, 8);
-        if (layout.nirOffset != 0) {
-            std::memcpy(column + layout.nirOffset, record + v14::kNir, 2);
+        return steps;
+    }();
+    return kRankSteps;
+}
+
+// Legacy fields mapped onto LAS 1.4's: 3-bit returns to nibbles, the class byte's flags to the
+// flags byte, the scan angle rank to 0.006 degree steps.
+template <bool GpsTime>
+void readLegacyColumn(const std::uint8_t* record, const LasColumnLayout& layout,
+                      const std::array<std::int16_t, 256>& steps, std::uint8_t* column) {
+    const std::uint8_t returns = record[legacy::kReturns];
+    const std::uint8_t classByte = record[legacy::kClass];
+    column[0] = classByte & 0x1f;
+    column[1] = static_cast<std::uint8_t>((returns & 0x07) | ((returns >> 3) & 0x07) << 4);
+    column[2] = static_cast<std::uint8_t>((classByte >> 5) | (returns & 0xc0));
+    column[3] = record[legacy::kUserData];
+    storeRaw(column + 4, steps[record[legacy::kScanRank]]);
+    std::memcpy(column + 6, record + legacy::kSourceId, 2);
+    if constexpr (GpsTime) {
+        std::memcpy(column + layout.gpsTimeOffset, record + legacy::kGpsTime, 8);
+    }
+}
+
+// LAS 1.4's returns and flags bytes are the column's; class and user data follow.
+template <bool Nir>
+void readV14Column(const std::uint8_t* record, const LasColumnLayout& layout,
+                   std::uint8_t* column) {
+    column[0] = record[v14::kClass];
+    column[1] = record[v14::kReturns];
+    column[2] = record[v14::kFlags];
+    column[3] = record[v14::kUserData];
+    std::memcpy(column + 4, record + v14::kScanAngle, 4); // scan angle, point source ID
+    std::memcpy(column + layout.gpsTimeOffset, record + v14::kGpsTime, 8);
+    if constexpr (Nir) {
+        std::memcpy(column + layout.nirOffset, record + v14::kNir, 2);
+    }
+}
+
+// The standard fields of each record by `read`, then the extra bytes where there are any.
+template <typename Read>
+void readColumns(const std::uint8_t* records, std::size_t count, std::size_t stride,
+                 std::uint8_t pointFormat, const LasColumnLayout& layout, std::uint8_t* columns,
+                 Read read) {
+    for (std::size_t i = 0; i < count; ++i) {
+        read(records + i * stride, columns + i * layout.bytes);
+    }
+    if (layout.extraBytes != 0) {
+        const std::size_t standard = minimumRecordLength(pointFormat);
+        for (std::size_t i = 0; i < count; ++i) {
+            std::memcpy(columns + i * layout.bytes + layout.extraOffset,
+                        records + i * stride + standard, layout.extraBytes);
         }
     }
-    std::memcpy(column + layout.extraOffset, record + minimumRecordLength(pointFormat),
-                layout.extraBytes);
+}
+
+} // namespace
+
+void readLasColumns(const std::uint8_t* records, std::size_t count, std::size_t stride,
+                    std::uint8_t pointFormat, const LasColumnLayout& layout, std::uint8_t* columns) {
+    if (pointFormat <= 5) {
+        const std::array<std::int16_t, 256>& steps = rankSteps();
+        if (layout.gpsTimeOffset != 0) {
+            readColumns(records, count, stride, pointFormat, layout, columns,
+                        [&](const std::uint8_t* record, std::uint8_t* column) {
+                            readLegacyColumn<true>(record, layout, steps, column);
+                        });
+        } else {
+            readColumns(records, count, stride, pointFormat, layout, columns,
+                        [&](const std::uint8_t* record, std::uint8_t* column) {
+                            readLegacyColumn<false>(record, layout, steps, column);
+                        });
+        }
+    } else if (layout.nirOffset != 0) {
+        readColumns(records, count, stride, pointFormat, layout, columns,
+                    [&](const std::uint8_t* record, std::uint8_t* column) {
+                        readV14Column<true>(record, layout, column);
+                    });
+    } else {
+        readColumns(records, count, stride, pointFormat, layout, columns,
+                    [&](const std::uint8_t* record, std::uint8_t* column) {
+                        readV14Column<false>(record, layout, column);
+                    });
+    }
+}
+
+void readLasColumn(const std::uint8_t* record, std::uint8_t pointFormat,
+                   const LasColumnLayout& layout, std::uint8_t* column) {
+    readLasColumns(record, 1, 0, pointFormat, layout, column);
 }
 
 LasFields readLasFields(const std::uint8_t* record, std::uint8_t pointFormat) {

@@ -29,6 +29,10 @@ LasFields readLasFields(const std::uint8_t* record, std::uint8_t pointFormat);
 // path, equal to encodeLasFields(readLasFields(record)) plus the extra bytes.
 void readLasColumn(const std::uint8_t* record, std::uint8_t pointFormat,
                    const LasColumnLayout& layout, std::uint8_t* column);
+// readLasColumn for `count` records `stride` bytes apart, into consecutive columns of
+// `layout.bytes`: the format's branches are taken once per block, not per point.
+void readLasColumns(const std::uint8_t* records, std::size_t count, std::size_t stride,
+                    std::uint8_t pointFormat, const LasColumnLayout& layout, std::uint8_t* columns);
 
 // Writes `fields` into `record` (of `pointFormat`, zeroed before): classification, returns,
 // flags, user data, scan angle, point source ID, and GPS time and NIR where the format has

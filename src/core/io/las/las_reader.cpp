@@ -89,11 +89,15 @@ private:
     }
 
     glm::u8vec3 color(const std::uint8_t* record) const {
-        const std::uint8_t* rgb = record + m_colorOffset;
+        return color(record + m_colorOffset, m_colorDepth == ColorDepth::SixteenBit);
+    }
+
+    // `rgb`: the record's three 16-bit channels.
+    static glm::u8vec3 color(const std::uint8_t* rgb, bool sixteenBit) {
         const int red = loadRaw<std::uint16_t>(rgb);
         const int green = loadRaw<std::uint16_t>(rgb + 2);
         const int blue = loadRaw<std::uint16_t>(rgb + 4);
-        if (m_colorDepth == ColorDepth::SixteenBit) {
+        if (sixteenBit) {
             return {(red + 128) / 257, (green + 128) / 257, (blue + 128) / 257};
         }
         // A channel above 255 that the sample missed is clamped rather than wrapped.
@@ -235,24 +239,49 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
         batch.clear();
         batch.las.resize(batchCapacity * lasBytes);
     };
+    // Loop invariants as locals: members read through `this` were reloaded after every store
+    // into the batch (the compiler cannot rule out that the stores alias them).
+    const glm::dvec3 scale = m_header.scale;
+    const glm::dvec3 offset = m_header.offset;
+    const glm::dvec3 low = bounds.min;
+    const glm::dvec3 high = bounds.max;
+    const bool sixteenBitColor = m_colorDepth == ColorDepth::SixteenBit;
+    const std::size_t colorOffset = m_colorOffset;
+    const std::uint8_t pointFormat = m_header.pointFormat;
     m_records->forEachBlock([&](const LasRecordBlock& block) {
-        for (std::uint64_t i = 0; i < block.count; ++i) {
-            const std::uint8_t* record = block.records + i * stride;
-            const glm::dvec3 source = sourcePosition(record);
-            if (!normalizer.inBounds(source)) {
-                throwOutOfBounds(normalizer, block.firstIndex + i, source);
+        // The block a batch's worth of records at a time: positions, intensities and colours
+        // point by point, then the LAS columns of the run in one call.
+        for (std::uint64_t i = 0; i < block.count;) {
+            const std::size_t at = batch.size();
+            const auto take = static_cast<std::size_t>(
+                std::min<std::uint64_t>(block.count - i, batchPoints - at));
+            const std::uint8_t* records = block.records + i * stride;
+            for (std::size_t j = 0; j < take; ++j) {
+                const std::uint8_t* record = records + j * stride;
+                const glm::dvec3 source =
+                    glm::dvec3(loadRaw<std::int32_t>(record), loadRaw<std::int32_t>(record + 4),
+                               loadRaw<std::int32_t>(record + 8)) *
+                        scale +
+                    offset;
+                if (!normalizer.inBounds(source)) {
+                    throwOutOfBounds(normalizer, block.firstIndex + i + j, source);
+                }
+                batch.positions.push_back(
+                    normalizer.toUnit(glm::clamp(source, low, high)));
+                batch.intensities.push_back(loadRaw<std::uint16_t>(record + las::kRecordIntensity));
             }
-            batch.positions.push_back(
-                normalizer.toUnit(glm::clamp(source, bounds.min, bounds.max)));
-            batch.intensities.push_back(loadRaw<std::uint16_t>(record + las::kRecordIntensity));
             if (hasColor) {
-                batch.colors.push_back(color(record));
+                for (std::size_t j = 0; j < take; ++j) {
+                    batch.colors.push_back(
+                        color(records + j * stride + colorOffset, sixteenBitColor));
+                }
             }
-            las::readLasColumn(record, m_header.pointFormat, lasLayout,
-                               batch.las.data() + (batch.positions.size() - 1) * lasBytes);
+            las::readLasColumns(records, take, stride, pointFormat, lasLayout,
+                                batch.las.data() + at * lasBytes);
+            i += take;
             if (batch.size() == batchPoints) {
                 deliver();
-                const bool morePoints = block.firstIndex + i + 1 < m_header.pointCount;
+                const bool morePoints = block.firstIndex + i < m_header.pointCount;
                 if (morePoints && cancelled()) {
                     summary.cancelled = true;
                     return false;
