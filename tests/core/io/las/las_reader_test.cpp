@@ -420,6 +420,31 @@ TEST(LasReaderTest, PointOutsideTheHeaderBoundsNamesItsRecord) {
     }
 }
 
+// The reader parses a block a batch's run at a time: a bad point deep in a later run of a
+// later batch is still named by its own record.
+TEST(LasReaderTest, PointOutsideTheBoundsInALaterBatchNamesItsRecord) {
+    test::TempDir dir;
+    const std::string path = dir.file("outside-later.las");
+    std::vector<std::uint8_t> bytes = writeValidLas(path, 2, 1, 500);
+    const std::size_t record = pointDataOffset(bytes) + 157 * 28;
+    put<std::int32_t>(bytes, record + 8, get<std::int32_t>(bytes, record + 8) + 20000);
+    test::writeBytes(path, bytes);
+    ReadOptions options;
+    options.batchPoints = 64; // record 157 is the 30th of the third batch
+    std::size_t delivered = 0;
+    try {
+        openLasReader(path, {})->read([&](const PointBatch& batch) { delivered += batch.size(); },
+                                  options);
+        FAIL() << "expected OutOfBounds";
+    } catch (const InputError& error) {
+        EXPECT_EQ(error.kind(), InputErrorKind::OutOfBounds);
+        EXPECT_EQ(error.location().value, record);
+        EXPECT_NE(error.detail().find("point record 157 (counting from 0)"), std::string::npos)
+            << error.what();
+    }
+    EXPECT_EQ(delivered, 128u) << "the two whole batches before it, nothing of the third";
+}
+
 TEST(LasReaderTest, KnownBoundsThatMissAPointFailTheRead) {
     test::TempDir dir;
     const std::string path = dir.file("known.las");
