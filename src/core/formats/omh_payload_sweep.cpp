@@ -53,34 +53,27 @@ public:
     // Encodes what is queued, in parallel, and writes it in order.
     void finish() {
         std::size_t next = 0;
+        const auto nextBlock = [&](tbb::flow_control& control) -> std::size_t {
+            if (next == m_blocks.size()) {
+                control.stop();
+                return 0;
+            }
+            return next++;
+        };
+        const auto encodeBlock = [&](std::size_t i) {
+            encode(i);
+            return i;
+        };
+        const auto writeBlock = [&](std::size_t i) { write(i); };
         // A token holds its buffer from the first stage to the last, and the last stage is
         // serial in order: block i starts only once block i - kTokens is written, so the
         // buffer i % kTokens is free.
         tbb::parallel_pipeline(
             kTokens,
-            tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
-                                                [&](tbb::flow_control& control) -> std::size_t {
-                                                    if (next == m_blocks.size()) {
-                                                        control.stop();
-                                                        return 0;
-                                                    }
-                                                    return next++;
-                                                }) &
+            tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order, nextBlock) &
                 tbb::make_filter<std::size_t, std::size_t>(tbb::filter_mode::parallel,
-                                                           [&](std::size_t i) {
-                                                               encode(i);
-                                                               return i;
-                                                           }) &
-                tbb::make_filter<std::size_t, void>(tbb::filter_mode::serial_in_order,
-                                                    [&](std::size_t i) {
-                                                        const Block& block = m_blocks[i];
-                                                        const std::vector<std::uint8_t>& bytes =
-                                                            m_buffers[i % kTokens];
-                                                        m_sinks[static_cast<std::size_t>(
-                                                                    block.level - m_firstLevel)]
-                                                            .addEncoded(bytes.data(),
-                                                                        bytes.size());
-                                                    }));
+                                                           encodeBlock) &
+                tbb::make_filter<std::size_t, void>(tbb::filter_mode::serial_in_order, writeBlock));
         m_blocks.clear();
     }
 
@@ -96,6 +89,13 @@ private:
             out += std::size_t{piece.last - piece.first} * m_layout.bytes;
         }
         m_cloud.keepWithinBudget(); // as the estimation does, per block
+    }
+
+    // Hashes and writes block i through its level's sink (the pipeline's serial stage).
+    void write(std::size_t i) {
+        const std::vector<std::uint8_t>& bytes = m_buffers[i % kTokens];
+        m_sinks[static_cast<std::size_t>(m_blocks[i].level - m_firstLevel)].addEncoded(
+            bytes.data(), bytes.size());
     }
 
     static constexpr std::size_t kBlockBytes = std::size_t{1} << 20;
