@@ -64,7 +64,9 @@ public:
             encode(i);
             return i;
         };
-        const auto writeBlock = [&](std::size_t i) { write(i); };
+        const auto writeBlock = [&](std::size_t i) {
+            write(i);
+        };
         // A token holds its buffer from the first stage to the last, and the last stage is
         // serial in order: block i starts only once block i - kTokens is written, so the
         // buffer i % kTokens is free.
@@ -84,8 +86,8 @@ private:
         bytes.resize(block.records * m_layout.bytes);
         std::uint8_t* out = bytes.data();
         for (const Piece& piece : block.pieces) {
-            encodeOmhRecords(m_cloud, m_layout, *piece.node, *piece.splats, piece.first,
-                             piece.last, out);
+            encodeOmhRecords(m_cloud, m_layout, *piece.node, *piece.splats, piece.first, piece.last,
+                             out);
             out += std::size_t{piece.last - piece.first} * m_layout.bytes;
         }
         m_cloud.keepWithinBudget(); // as the estimation does, per block

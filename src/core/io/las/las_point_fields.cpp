@@ -134,30 +134,26 @@ void readColumns(const std::uint8_t* records, std::size_t count, std::size_t str
 } // namespace
 
 void readLasColumns(const std::uint8_t* records, std::size_t count, std::size_t stride,
-                    std::uint8_t pointFormat, const LasColumnLayout& layout, std::uint8_t* columns) {
+                    std::uint8_t pointFormat, const LasColumnLayout& layout,
+                    std::uint8_t* columns) {
+    const auto run = [&](auto read) {
+        readColumns(records, count, stride, pointFormat, layout, columns, read);
+    };
     if (pointFormat <= 5) {
         const std::array<std::int16_t, 256>& steps = rankSteps();
         if (layout.gpsTimeOffset != 0) {
-            readColumns(records, count, stride, pointFormat, layout, columns,
-                        [&](const std::uint8_t* record, std::uint8_t* column) {
-                            readLegacyColumn<true>(record, layout, steps, column);
-                        });
+            run([&](const std::uint8_t* r, std::uint8_t* c) {
+                readLegacyColumn<true>(r, layout, steps, c);
+            });
         } else {
-            readColumns(records, count, stride, pointFormat, layout, columns,
-                        [&](const std::uint8_t* record, std::uint8_t* column) {
-                            readLegacyColumn<false>(record, layout, steps, column);
-                        });
+            run([&](const std::uint8_t* r, std::uint8_t* c) {
+                readLegacyColumn<false>(r, layout, steps, c);
+            });
         }
     } else if (layout.nirOffset != 0) {
-        readColumns(records, count, stride, pointFormat, layout, columns,
-                    [&](const std::uint8_t* record, std::uint8_t* column) {
-                        readV14Column<true>(record, layout, column);
-                    });
+        run([&](const std::uint8_t* r, std::uint8_t* c) { readV14Column<true>(r, layout, c); });
     } else {
-        readColumns(records, count, stride, pointFormat, layout, columns,
-                    [&](const std::uint8_t* record, std::uint8_t* column) {
-                        readV14Column<false>(record, layout, column);
-                    });
+        run([&](const std::uint8_t* r, std::uint8_t* c) { readV14Column<false>(r, layout, c); });
     }
 }
 

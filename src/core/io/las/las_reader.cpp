@@ -82,10 +82,16 @@ private:
     }
 
     glm::dvec3 sourcePosition(const std::uint8_t* record) const {
+        return sourcePosition(record, m_header.scale, m_header.offset);
+    }
+
+    // The record's X, Y and Z integers in source units.
+    static glm::dvec3 sourcePosition(const std::uint8_t* record, const glm::dvec3& scale,
+                                     const glm::dvec3& offset) {
         return glm::dvec3(loadRaw<std::int32_t>(record), loadRaw<std::int32_t>(record + 4),
                           loadRaw<std::int32_t>(record + 8)) *
-                   m_header.scale +
-               m_header.offset;
+                   scale +
+               offset;
     }
 
     glm::u8vec3 color(const std::uint8_t* record) const {
@@ -258,16 +264,11 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
             const std::uint8_t* records = block.records + i * stride;
             for (std::size_t j = 0; j < take; ++j) {
                 const std::uint8_t* record = records + j * stride;
-                const glm::dvec3 source =
-                    glm::dvec3(loadRaw<std::int32_t>(record), loadRaw<std::int32_t>(record + 4),
-                               loadRaw<std::int32_t>(record + 8)) *
-                        scale +
-                    offset;
+                const glm::dvec3 source = sourcePosition(record, scale, offset);
                 if (!normalizer.inBounds(source)) {
                     throwOutOfBounds(normalizer, block.firstIndex + i + j, source);
                 }
-                batch.positions.push_back(
-                    normalizer.toUnit(glm::clamp(source, low, high)));
+                batch.positions.push_back(normalizer.toUnit(glm::clamp(source, low, high)));
                 batch.intensities.push_back(loadRaw<std::uint16_t>(record + las::kRecordIntensity));
             }
             if (hasColor) {

@@ -171,7 +171,8 @@ TEST(LasFields, ReadLasColumnsOfARunEqualTheFieldConversion) {
             for (const std::size_t gap : {0, 5}) {
                 SCOPED_TRACE(testing::Message() << "format " << int(format) << ", extra bytes "
                                                 << extra << ", gap " << gap);
-                const auto length = static_cast<std::uint16_t>(las::minimumRecordLength(format) + extra);
+                const auto length =
+                    static_cast<std::uint16_t>(las::minimumRecordLength(format) + extra);
                 const AttributeSet attributes = las::attributesOfFormat(format, length);
                 const LasColumnLayout layout = LasColumnLayout::of(attributes);
                 const std::size_t stride = length + gap;
@@ -181,15 +182,18 @@ TEST(LasFields, ReadLasColumnsOfARunEqualTheFieldConversion) {
                     byte = static_cast<std::uint8_t>(random());
                 }
                 std::vector<std::uint8_t> columns(kRecords * layout.bytes, 0xee);
-                las::readLasColumns(records.data(), kRecords, stride, format, layout, columns.data());
+                las::readLasColumns(records.data(), kRecords, stride, format, layout,
+                                    columns.data());
                 for (std::size_t i = 0; i < kRecords; ++i) {
                     const std::uint8_t* record = records.data() + i * stride;
                     std::vector<std::uint8_t> expected(layout.bytes);
-                    encodeLasFields(attributes, las::readLasFields(record, format), expected.data());
+                    encodeLasFields(attributes, las::readLasFields(record, format),
+                                    expected.data());
                     std::memcpy(expected.data() + layout.extraOffset,
                                 record + las::minimumRecordLength(format), extra);
                     const std::vector<std::uint8_t> column(columns.begin() + i * layout.bytes,
-                                                           columns.begin() + (i + 1) * layout.bytes);
+                                                           columns.begin() +
+                                                               (i + 1) * layout.bytes);
                     ASSERT_EQ(column, expected) << "record " << i;
                 }
             }

@@ -434,7 +434,7 @@ TEST(LasReaderTest, PointOutsideTheBoundsInALaterBatchNamesItsRecord) {
     std::size_t delivered = 0;
     try {
         openLasReader(path, {})->read([&](const PointBatch& batch) { delivered += batch.size(); },
-                                  options);
+                                      options);
         FAIL() << "expected OutOfBounds";
     } catch (const InputError& error) {
         EXPECT_EQ(error.kind(), InputErrorKind::OutOfBounds);
