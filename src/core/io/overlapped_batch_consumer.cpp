@@ -1,5 +1,7 @@
 #include "io/overlapped_batch_consumer.hpp"
 
+#include "points/morton_batch.hpp"
+
 #include <utility>
 
 namespace omicron {
@@ -19,10 +21,7 @@ void OverlappedBatchConsumer::push(const PointBatch& batch) {
     }
     m_waiting = batch; // reuses the buffer's capacity after the first batches
     m_waitingCodes.resize(batch.size());
-    for (std::size_t i = 0; i < batch.size(); ++i) {
-        const glm::vec3& p = batch.positions[i];
-        m_waitingCodes[i] = morton::encodeUnit(p.x, p.y, p.z);
-    }
+    morton::encodeUnitBatch(batch.positions, m_waitingCodes);
     m_hasWaiting = true;
     m_changed.notify_all();
 }

@@ -4,6 +4,7 @@
 #include "memory_budget.hpp"
 #include "points/huge_page_buffer.hpp"
 #include "points/huge_page_policy.hpp"
+#include "points/morton_batch.hpp"
 #include "sort/budgeted_cloud.hpp"
 #include "sort/radix_sort.hpp"
 #include "sort/run_merger.hpp"
@@ -138,10 +139,9 @@ void IncrementalMortonSorter::add(const PointBatch& batch) {
     m_batchCodes.resize(count);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 8192),
                       [&](const tbb::blocked_range<std::size_t>& range) {
-                          for (std::size_t i = range.begin(); i < range.end(); ++i) {
-                              const glm::vec3& p = batch.positions[i];
-                              m_batchCodes[i] = morton::encodeUnit(p.x, p.y, p.z);
-                          }
+                          morton::encodeUnitBatch(
+                              std::span(batch.positions).subspan(range.begin(), range.size()),
+                              std::span(m_batchCodes).subspan(range.begin(), range.size()));
                       });
     add(batch, m_batchCodes);
 }
