@@ -6,15 +6,26 @@
 
 namespace omicron {
 
-OverlappedBatchConsumer::OverlappedBatchConsumer(Consumer consume)
-    : m_consume(std::move(consume)), m_worker([this](std::stop_token stop) { work(stop); }) {}
+OverlappedBatchConsumer::OverlappedBatchConsumer(Consumer consume, Helper whileWaiting)
+    : m_consume(std::move(consume)), m_help(std::move(whileWaiting)),
+      m_worker([this](std::stop_token stop) { work(stop); }) {}
 
 OverlappedBatchConsumer::~OverlappedBatchConsumer() {
     stopWorker();
 }
 
 void OverlappedBatchConsumer::push(const PointBatch& batch) {
+    m_pointsPushed += batch.size();
     std::unique_lock lock(m_mutex);
+    // Helps, a step at a time, rather than idle while the worker still holds a batch.
+    while (m_help && m_hasWaiting && !m_failure) {
+        lock.unlock();
+        const bool helped = m_help(m_pointsPushed);
+        lock.lock();
+        if (!helped) {
+            break;
+        }
+    }
     m_changed.wait(lock, [&] { return !m_hasWaiting || m_failure; });
     if (m_failure) {
         std::rethrow_exception(m_failure);

@@ -7,8 +7,9 @@
 // (two of them, reused) and computes its points' Morton codes, and returns, so the reader parses
 // batch k + 1 while a worker thread consumes batch k. The codes are the reader thread's share
 // because the sorter's share (bins, the copy into the arrival-order arrays and its page
-// faults) is the longer one: the reader waited for it. Batches are consumed in order, each
-// exactly once.
+// faults) is the longer one: the reader waited for it. Where it still waits, it may help
+// instead (the sorter's page faults ahead, IncrementalMortonSorter::populateAhead). Batches
+// are consumed in order, each exactly once.
 #pragma once
 
 #include "points/morton.hpp"
@@ -28,7 +29,12 @@ public:
     // A batch and the level-21 codes of its points (morton::encodeUnit), one per point.
     using Consumer = std::function<void(const PointBatch&, std::span<const morton::Code>)>;
 
-    explicit OverlappedBatchConsumer(Consumer consume);
+    // Work the reader thread may do while the worker still holds the previous batch, a small
+    // step per call, given the points read so far (the batch being pushed included); returns
+    // false when it has nothing to do (the reader then waits).
+    using Helper = std::function<bool(std::size_t pointsRead)>;
+
+    explicit OverlappedBatchConsumer(Consumer consume, Helper whileWaiting = {});
     // Without finish() (the reader threw): waits for the batch being consumed, drops the one
     // waiting.
     ~OverlappedBatchConsumer();
@@ -49,6 +55,8 @@ private:
     void rethrowFailure();
 
     Consumer m_consume;
+    Helper m_help;
+    std::size_t m_pointsPushed = 0; // reader thread only
     std::mutex m_mutex;
     std::condition_variable_any m_changed;
     PointBatch m_waiting;         // the next batch, copied by push (guarded by m_mutex)

@@ -319,12 +319,16 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
     readOptions.cancel = &m_cancel;
     const auto readStart = Clock::now();
     // The sorter takes each batch on a thread of its own while the reader parses the next.
-    OverlappedBatchConsumer sorterInput([&](const PointBatch& batch,
-                                            std::span<const morton::Code> codes) {
-        sorter->add(batch, codes);
-        m_pointsRead.fetch_add(batch.size(), std::memory_order_relaxed);
-        m_sortRuns.store(sorter->runCount(), std::memory_order_relaxed);
-    });
+    OverlappedBatchConsumer sorterInput(
+        [&](const PointBatch& batch, std::span<const morton::Code> codes) {
+            sorter->add(batch, codes);
+            m_pointsRead.fetch_add(batch.size(), std::memory_order_relaxed);
+            m_sortRuns.store(sorter->runCount(), std::memory_order_relaxed);
+        },
+        [&](std::size_t pointsRead) {
+            // The next batch's arrival pages, while the sorter still adds the last.
+            return sorter->populateAhead(pointsRead + readOptions.batchPoints);
+        });
     const ReadSummary read =
         reader->read([&](const PointBatch& batch) { sorterInput.push(batch); }, readOptions);
     sorterInput.finish();

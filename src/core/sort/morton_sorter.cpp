@@ -122,6 +122,17 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
     advise(m_input.colors);
     advise(m_input.intensities);
     advise(m_input.las);
+    const auto column = [](auto& array, std::size_t pointBytes) {
+        return ArrivalColumn{array.capacity() == 0 ? nullptr
+                                                   : reinterpret_cast<std::byte*>(array.data()),
+                             pointBytes};
+    };
+    m_arrivalCapacity = capacity;
+    m_arrivalColumns = {column(m_input.positions, sizeof(glm::vec3)),
+                        column(m_input.normals, sizeof(glm::vec3)),
+                        column(m_input.colors, sizeof(m_input.colors[0])),
+                        column(m_input.intensities, sizeof(m_input.intensities[0])),
+                        column(m_input.las, m_input.attributes.lasBytes())};
     if (m_options.recyclePages.value_or(!hugePagesPayOff())) {
         const SortedCloud::InPlaceArrays sorted = m_cloud->inPlaceArrays();
         const std::array<std::span<std::byte>, kColumns> recipients{
@@ -169,17 +180,46 @@ void IncrementalMortonSorter::add(const PointBatch& batch, std::span<const morto
         std::uint16_t& lastBin = m_blockLastBin[(firstIndex + i) >> kReleaseBlockBits];
         lastBin = std::max(lastBin, binIndex);
     }
-    // The arrival arrays are reserved for the whole cloud and filled batch by batch: each
-    // batch's new pages are faulted in by one call per array before the copy.
-    const auto populate = [&](const auto& to, const auto& from) {
-        populatePages(to.data() + to.size(), from.size() * sizeof(from[0]));
-    };
-    populate(m_input.positions, batch.positions);
-    populate(m_input.normals, batch.normals);
-    populate(m_input.colors, batch.colors);
-    populate(m_input.intensities, batch.intensities);
-    populate(m_input.las, batch.las);
+    // The arrival arrays are reserved for the whole cloud and filled batch by batch: the
+    // batch's new pages are faulted in by one call per array before the copy, unless
+    // populateAhead() has claimed them already.
+    populateUpTo(firstIndex + count);
     m_input.append(batch);
+}
+
+void IncrementalMortonSorter::populateArrival(std::size_t begin, std::size_t end) const {
+    for (const ArrivalColumn& column : m_arrivalColumns) {
+        if (column.base != nullptr && column.pointBytes != 0) {
+            populatePages(column.base + begin * column.pointBytes,
+                          (end - begin) * column.pointBytes);
+        }
+    }
+}
+
+void IncrementalMortonSorter::populateUpTo(std::size_t end) {
+    std::size_t from = m_populated.load(std::memory_order_relaxed);
+    while (from < end && !m_populated.compare_exchange_weak(from, end, std::memory_order_relaxed)) {
+    }
+    if (from < end) {
+        populateArrival(from, end);
+    }
+}
+
+bool IncrementalMortonSorter::populateAhead(std::size_t limit) {
+    // A step is about 0.5 MB of pages for a LAS cloud: short enough that the reader soon
+    // sees the sorter take its batch.
+    constexpr std::size_t kStepPoints = std::size_t{1} << 14;
+    limit = std::min(limit, m_arrivalCapacity);
+    std::size_t from = m_populated.load(std::memory_order_relaxed);
+    std::size_t to = 0;
+    do {
+        if (from >= limit) {
+            return false;
+        }
+        to = std::min(limit, from + kStepPoints);
+    } while (!m_populated.compare_exchange_weak(from, to, std::memory_order_relaxed));
+    populateArrival(from, to);
+    return true;
 }
 
 PreviewSample IncrementalMortonSorter::preview() const {
@@ -461,6 +501,9 @@ SortSummary sortPointCloud(PointReader& reader, const SortOptions& options,
     OverlappedBatchConsumer sorterInput(
         [&](const PointBatch& batch, std::span<const morton::Code> codes) {
             sorter.add(batch, codes);
+        },
+        [&](std::size_t pointsRead) {
+            return sorter.populateAhead(pointsRead + readOptions.batchPoints);
         });
     summary.read =
         reader.read([&](const PointBatch& batch) { sorterInput.push(batch); }, readOptions);

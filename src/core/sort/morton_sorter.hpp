@@ -86,6 +86,13 @@ public:
     // position, one per point), as OverlappedBatchConsumer hands them over.
     void add(const PointBatch& batch, std::span<const morton::Code> codes);
 
+    // Any thread, while another calls add(): faults in the arrival-order pages of the next
+    // points whose pages no add() or earlier call has claimed, below `limit` points (a step of
+    // them at a time). Returns false when there is nothing left to claim below `limit`. The
+    // reader thread calls it while it waits for the sorter's thread (OverlappedBatchConsumer),
+    // taking over part of the page faults that otherwise make the sorter's side the longer.
+    bool populateAhead(std::size_t limit);
+
     // Any thread, any time: a copy of the current preview sample (bounded size).
     PreviewSample preview() const;
 
@@ -153,6 +160,19 @@ private:
     // the kernel).
     enum Column : std::size_t { kPositions, kNormals, kColors, kIntensities, kLas, kColumns };
     std::array<std::unique_ptr<PageRecycler>, kColumns> m_recyclers;
+    // Per column, the arrival array's reserved memory and bytes per point (null: no column),
+    // fixed once reserved: populateAhead() uses these, never the arrays themselves.
+    struct ArrivalColumn {
+        std::byte* base = nullptr;
+        std::size_t pointBytes = 0;
+    };
+    std::array<ArrivalColumn, kColumns> m_arrivalColumns;
+    std::size_t m_arrivalCapacity = 0; // points the arrival arrays have room for
+    // Points whose arrival pages are faulted in, or claimed by a thread doing it.
+    std::atomic<std::size_t> m_populated{0};
+    void populateArrival(std::size_t begin, std::size_t end) const;
+    // Claims [m_populated, end) and faults its pages in (add()'s own batch).
+    void populateUpTo(std::size_t end);
     std::size_t m_pagesRecycled = 0;
     std::vector<Bin> m_bins;
     std::vector<std::uint16_t> m_blockLastBin;

@@ -1,14 +1,15 @@
 // The reader's batches consumed on a thread of their own: every batch once, in order, with its
-// content and its points' Morton codes; a consumer's exception reaches the reader; giving up part way neither hangs nor
-// consumes what was left waiting.
+// content and its points' Morton codes; the reader helps while it waits; a consumer's exception
+// reaches the reader; giving up part way neither hangs nor consumes what was left waiting.
 #include "io/overlapped_batch_consumer.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <gtest/gtest.h>
-#include <stdexcept>
 #include <span>
+#include <stdexcept>
 #include <thread>
 #include <vector>
 
@@ -65,6 +66,58 @@ TEST(OverlappedBatchConsumer, ConsumesEveryBatchOnceInOrderWithItsContent) {
         }
         EXPECT_EQ(batchOfPoint, expectedBatches);
         EXPECT_EQ(wrongCodes, 0u);
+    }
+}
+
+// While the worker still holds a batch, the reader runs the helper (on its own thread, with the
+// points read so far) until the helper has nothing to do; batches still arrive in order.
+TEST(OverlappedBatchConsumer, TheReaderHelpsWhileTheWorkerHoldsABatch) {
+    const std::thread::id reader = std::this_thread::get_id();
+    std::vector<float> xs;
+    std::atomic<bool> consuming{false};
+    std::size_t helpCalls = 0;
+    std::size_t wrongThread = 0;
+    std::vector<std::size_t> pointsReadSeen;
+    std::size_t stepsLeft = 0; // the helper's work for the current push
+    OverlappedBatchConsumer consumer(
+        [&](const PointBatch& batch, std::span<const morton::Code>) {
+            consuming = true;
+            for (const glm::vec3& p : batch.positions) {
+                xs.push_back(p.x);
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(3));
+            consuming = false;
+        },
+        [&](std::size_t pointsRead) {
+            ++helpCalls;
+            wrongThread += std::this_thread::get_id() != reader ? 1 : 0;
+            pointsReadSeen.push_back(pointsRead);
+            if (stepsLeft == 0) {
+                return false;
+            }
+            --stepsLeft;
+            std::this_thread::sleep_for(std::chrono::microseconds(200));
+            return true;
+        });
+    std::size_t nextPoint = 0;
+    std::vector<std::size_t> pushedTotals;
+    for (std::size_t k = 0; k < 40; ++k) {
+        stepsLeft = 3;
+        consumer.push(batchNumber(k, nextPoint));
+        pushedTotals.push_back(nextPoint);
+    }
+    consumer.finish();
+    EXPECT_FALSE(consuming.load());
+    EXPECT_EQ(wrongThread, 0u);
+    EXPECT_GT(helpCalls, 0u) << "a worker 3 ms a batch behind never made the reader wait";
+    for (const std::size_t seen : pointsReadSeen) {
+        EXPECT_TRUE(std::find(pushedTotals.begin(), pushedTotals.end(), seen) != pushedTotals.end())
+            << seen << " is not the point count of a push";
+    }
+    EXPECT_TRUE(std::is_sorted(pointsReadSeen.begin(), pointsReadSeen.end()));
+    ASSERT_EQ(xs.size(), nextPoint);
+    for (std::size_t i = 0; i < xs.size(); ++i) {
+        ASSERT_EQ(xs[i], static_cast<float>(i) / 4096.0f) << "point " << i;
     }
 }
 

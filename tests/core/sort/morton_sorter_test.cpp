@@ -5,11 +5,13 @@
 #include "test_files.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <gtest/gtest.h>
 #include <optional>
 #include <random>
 #include <tbb/global_control.h>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -81,13 +83,34 @@ struct SortRun {
     std::size_t pagesRecycled = 0;
 };
 
+// `populating`: another thread faults the arrival pages in ahead of add() meanwhile
+// (populateAhead, as the reader does while it waits for the sorter).
 SortRun sortCloud(const SyntheticCloud& cloud, int chunks, std::size_t feedBatch = 10000,
-                  std::size_t emitBatch = 5000, std::optional<bool> recyclePages = std::nullopt) {
+                  std::size_t emitBatch = 5000, std::optional<bool> recyclePages = std::nullopt,
+                  bool populating = false) {
     SortOptions options;
     options.chunks = chunks;
     options.batchPoints = emitBatch;
     options.recyclePages = recyclePages;
     IncrementalMortonSorter sorter(cloud.info, options);
+    std::atomic<std::size_t> added{0};
+    std::atomic<bool> reading{true};
+    std::thread populator;
+    if (populating) {
+        populator = std::thread([&] {
+            while (reading.load()) {
+                if (!sorter.populateAhead(added.load() + 2 * feedBatch)) {
+                    std::this_thread::yield();
+                }
+            }
+        });
+    }
+    const auto stopPopulating = [&] {
+        reading = false;
+        if (populator.joinable()) {
+            populator.join();
+        }
+    };
     for (std::size_t begin = 0; begin < cloud.points.size(); begin += feedBatch) {
         const std::size_t end = std::min(cloud.points.size(), begin + feedBatch);
         PointBatch batch;
@@ -100,7 +123,9 @@ SortRun sortCloud(const SyntheticCloud& cloud, int chunks, std::size_t feedBatch
         batch.intensities.assign(cloud.points.intensities.begin() + begin,
                                  cloud.points.intensities.begin() + end);
         sorter.add(batch);
+        added = end;
     }
+    stopPopulating();
     SortRun run;
     morton::Code maxEmitted = 0;
     sorter.sortAndEmit([&](const SortedCloud& sorted, std::size_t begin, std::size_t end) {
@@ -198,6 +223,54 @@ TEST(MortonSorter, InputPagesMovedIntoTheSortedCloudKeepEveryAttribute) {
             }
         }
     }
+}
+
+// The reader faults arrival pages in while the sorter adds: the sort is the same point for
+// point, whichever thread touched a page first, and pages moved into the sorted cloud later
+// still carry their own points.
+TEST(MortonSorter, ArrivalPagesPopulatedFromAnotherThreadKeepEveryAttribute) {
+    for (const Shape shape : {Shape::Random, Shape::MortonOrdered}) {
+        SCOPED_TRACE(static_cast<int>(shape));
+        const SyntheticCloud cloud = makeCloud(shape, 330000, 13);
+        const SortRun reference = sortCloud(cloud, 32);
+        for (const bool recycle : {true, false}) {
+            const SortRun run = sortCloud(cloud, 32, 7000, 5000, recycle, true);
+            expectSortedPermutation(cloud, run);
+            EXPECT_EQ(run.codes, reference.codes);
+            EXPECT_EQ(run.normals, reference.normals);
+        }
+    }
+}
+
+// populateAhead claims each point's pages once, a step at a time, never past the limit or the
+// declared count; a spilling sort has nothing to populate.
+TEST(MortonSorter, PopulateAheadClaimsUpToTheLimitAndTheDeclaredCount) {
+    const SyntheticCloud cloud = makeCloud(Shape::Random, 50000, 17);
+    IncrementalMortonSorter sorter(cloud.info, {});
+    EXPECT_FALSE(sorter.populateAhead(0));
+    EXPECT_TRUE(sorter.populateAhead(10));
+    EXPECT_FALSE(sorter.populateAhead(10)) << "claimed twice";
+    std::size_t steps = 0;
+    while (sorter.populateAhead(1'000'000)) {
+        ++steps;
+        ASSERT_LT(steps, 100u) << "claims past the declared 50000 points";
+    }
+    EXPECT_EQ(steps, (50000u - 10u + 16383u) / 16384u);
+    sorter.add(cloud.points); // pages claimed ahead: add() copies into them
+    std::vector<morton::Code> codes;
+    sorter.sortAndEmit([&](const SortedCloud& sorted, std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+            codes.push_back(sorted.code(i));
+        }
+    });
+    ASSERT_EQ(codes.size(), 50000u);
+    EXPECT_TRUE(std::is_sorted(codes.begin(), codes.end()));
+
+    SortOptions spilling;
+    spilling.memoryBudgetBytes = 1 << 20;
+    IncrementalMortonSorter spiller(cloud.info, spilling);
+    ASSERT_TRUE(spiller.spills());
+    EXPECT_FALSE(spiller.populateAhead(1000));
 }
 
 TEST(MortonSorter, IdenticalForEveryChunkCountAndThreadCount) {
