@@ -45,17 +45,47 @@ inline std::uint32_t quantizeLane(float unit) {
     }
 }
 
-} // namespace
+using BatchEncoder = void (*)(std::span<const glm::vec3>, std::span<Code>);
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#endif
-void encodeUnitBatch(std::span<const glm::vec3> positions, std::span<Code> codes) {
+void encodeBaseline(std::span<const glm::vec3> positions, std::span<Code> codes) {
     encodeLoop(positions, codes);
 }
 
-void detail::encodeUnitBatchBaseline(std::span<const glm::vec3> positions, std::span<Code> codes) {
+#if defined(__x86_64__) && defined(__GNUC__)
+[[gnu::target("avx512f,avx512dq,avx512bw,avx512vl")]] void
+encodeAvx512(std::span<const glm::vec3> positions, std::span<Code> codes) {
     encodeLoop(positions, codes);
+}
+
+[[gnu::target("avx2")]] void encodeAvx2(std::span<const glm::vec3> positions,
+                                        std::span<Code> codes) {
+    encodeLoop(positions, codes);
+}
+#endif
+
+} // namespace
+
+std::vector<detail::BatchEncoderVariant> detail::batchEncoders() {
+    std::vector<BatchEncoderVariant> variants{{"baseline", &encodeBaseline}};
+#if defined(__x86_64__) && defined(__GNUC__)
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx2")) {
+        variants.push_back({"avx2", &encodeAvx2});
+    }
+    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+        __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl")) {
+        variants.push_back({"avx512", &encodeAvx512});
+    }
+#endif
+    return variants;
+}
+
+// The widest variant, chosen on first use. Not an ifunc (target_clones): its resolver runs
+// while the dynamic loader relocates, before a sanitizer's runtime is up, and crashed the TSan
+// build.
+void encodeUnitBatch(std::span<const glm::vec3> positions, std::span<Code> codes) {
+    static const BatchEncoder encode = detail::batchEncoders().back().encode;
+    encode(positions, codes);
 }
 
 } // namespace omicron::morton

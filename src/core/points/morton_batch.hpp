@@ -3,14 +3,15 @@
 //
 // Bit for bit morton::encodeUnit of each position. One point at a time the byte table of
 // morton.hpp is the fastest spread; over a batch the shift-and-mask spread runs on vector
-// lanes instead, compiled for AVX-512 and AVX2 too and picked when the process starts (on a
-// CPU without them, the baseline x86-64 build of the same loop runs).
+// lanes instead, compiled for AVX-512 and AVX2 too and picked on first use (on a CPU without
+// them, the baseline x86-64 build of the same loop runs).
 #pragma once
 
 #include "points/morton.hpp"
 
 #include <glm/vec3.hpp>
 #include <span>
+#include <vector>
 
 namespace omicron::morton {
 
@@ -18,9 +19,13 @@ namespace omicron::morton {
 void encodeUnitBatch(std::span<const glm::vec3> positions, std::span<Code> codes);
 
 namespace detail {
-// The same loop compiled for baseline x86-64 only (SSE2): what encodeUnitBatch runs on a CPU
-// without AVX2; tests compare it too, whatever CPU runs them.
-void encodeUnitBatchBaseline(std::span<const glm::vec3> positions, std::span<Code> codes);
+// A compiled variant of the batch encoder: baseline x86-64 (SSE2), AVX2, AVX-512.
+struct BatchEncoderVariant {
+    const char* name;
+    void (*encode)(std::span<const glm::vec3> positions, std::span<Code> codes);
+};
+// Every variant this CPU can run, the baseline first (tests compare them all).
+std::vector<BatchEncoderVariant> batchEncoders();
 } // namespace detail
 
 } // namespace omicron::morton

@@ -1,5 +1,5 @@
-// The batch Morton encoder is bit for bit morton::encodeUnit, on the vector path this CPU
-// picks and on the baseline one, over vector tails and every value quantize() clamps.
+// The batch Morton encoder is bit for bit morton::encodeUnit, in every compiled variant this
+// CPU can run (baseline, AVX2, AVX-512), over vector tails and every value quantize() clamps.
 #include "points/morton_batch.hpp"
 
 #include <cmath>
@@ -80,12 +80,18 @@ void expectEqualsEncodeUnit(BatchEncoder encode) {
     }
 }
 
-TEST(MortonBatch, EqualsEncodeUnitOnThisCpusPath) {
-    expectEqualsEncodeUnit(&morton::encodeUnitBatch);
+TEST(MortonBatch, EveryVariantThisCpuRunsEqualsEncodeUnit) {
+    const auto variants = morton::detail::batchEncoders();
+    ASSERT_FALSE(variants.empty());
+    EXPECT_STREQ(variants.front().name, "baseline");
+    for (const auto& variant : variants) {
+        SCOPED_TRACE(variant.name);
+        expectEqualsEncodeUnit(variant.encode);
+    }
 }
 
-TEST(MortonBatch, EqualsEncodeUnitOnTheBaselinePath) {
-    expectEqualsEncodeUnit(&morton::detail::encodeUnitBatchBaseline);
+TEST(MortonBatch, TheEntryPointEqualsEncodeUnit) {
+    expectEqualsEncodeUnit(&morton::encodeUnitBatch);
 }
 
 } // namespace
