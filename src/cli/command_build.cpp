@@ -8,12 +8,15 @@
 #include "json_writer.hpp"
 #include "levels_json.hpp"
 #include "pipeline/build_pipeline.hpp"
+#include "points/huge_page_buffer.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
 #include <thread>
 
 namespace omicron::cli {
@@ -85,6 +88,29 @@ void printJson(const PipelineResult& run, const BuildOptions& options, const Sav
     std::printf("%s\n", json.text().c_str());
 }
 
+// The kernel frees an exiting process's pages on one core: 75 ms of `build --save`'s 1.5 s on
+// 24.2 M LAS points here, with the other core idle. MADV_DONTNEED takes the address space's
+// lock for reading only, so slices of the cloud's arrays given back on every core free
+// together (about 40 ms on two cores), and what is left to unmap is cheap. The cloud reads as
+// zeros afterwards (a file-backed one from its file): call it when nothing reads it again.
+void dropCloudPagesOnAllCores(const SortedCloud& cloud) {
+    const auto drop = [](const auto& array) {
+        constexpr std::size_t kSliceBytes = std::size_t{8} << 20;
+        const auto* bytes = reinterpret_cast<const std::uint8_t*>(array.data());
+        const std::size_t size = array.size_bytes();
+        tbb::parallel_for(std::size_t{0}, (size + kSliceBytes - 1) / kSliceBytes,
+                          [&](std::size_t slice) {
+                              const std::size_t begin = slice * kSliceBytes;
+                              releasePages(bytes + begin, std::min(kSliceBytes, size - begin));
+                          });
+    };
+    drop(cloud.positions());
+    drop(cloud.normals());
+    drop(cloud.colors());
+    drop(cloud.intensities());
+    drop(cloud.lasColumn());
+}
+
 void printText(const PipelineResult& run, const BuildOptions& options, const SavedFile& saved) {
     const BuildStatistics& s = run.stats;
     std::printf("pipeline:    %s\n", run.pipeline.c_str());
@@ -149,6 +175,9 @@ int runBuild(const std::vector<std::string>& args) {
         printJson(run, options, saved);
     } else {
         printText(run, options, saved);
+    }
+    if (const auto hierarchy = pipeline.hierarchy()) { // last: nothing reads it after this
+        dropCloudPagesOnAllCores(hierarchy->cloud());
     }
     return 0;
 }
