@@ -365,9 +365,17 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                        // Sorted bins are not read again: their memory goes back now, so the
                        // sorted cloud filling up reuses it instead of raising the peak.
                        from = Bin{};
-                       for (std::size_t i = at; i < at + n; ++i) {
-                           const glm::vec3& p = m_input.positions[indices[i]];
-                           keys[i] = morton::encodeUnit(p.x, p.y, p.z);
+                       // The bin's positions, gathered a block at a time, coded on vector
+                       // lanes.
+                       constexpr std::size_t kKeyBlock = 512;
+                       std::array<glm::vec3, kKeyBlock> gathered;
+                       for (std::size_t first = at; first < at + n; first += kKeyBlock) {
+                           const std::size_t count = std::min(kKeyBlock, at + n - first);
+                           for (std::size_t i = 0; i < count; ++i) {
+                               gathered[i] = m_input.positions[indices[first + i]];
+                           }
+                           morton::encodeUnitBatch(std::span(gathered.data(), count),
+                                                   std::span(keys.data() + first, count));
                        }
                        radixSortByKey(std::span(keys.data() + at, n),
                                       std::span(indices.data() + at, n),
