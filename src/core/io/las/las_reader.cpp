@@ -262,14 +262,28 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
             const auto take = static_cast<std::size_t>(
                 std::min<std::uint64_t>(block.count - i, batchPoints - at));
             const std::uint8_t* records = block.records + i * stride;
+            // Written through pointers, the bounds test folded into one flag: a loop without
+            // a branch or a push_back per point. The first point out of bounds is found again
+            // for its error.
+            batch.positions.resize(at + take);
+            batch.intensities.resize(at + take);
+            glm::vec3* positions = batch.positions.data() + at;
+            std::uint16_t* intensities = batch.intensities.data() + at;
+            bool allInBounds = true;
             for (std::size_t j = 0; j < take; ++j) {
                 const std::uint8_t* record = records + j * stride;
                 const glm::dvec3 source = sourcePosition(record, scale, offset);
-                if (!normalizer.inBounds(source)) {
-                    throwOutOfBounds(normalizer, block.firstIndex + i + j, source);
+                allInBounds &= normalizer.inBounds(source);
+                positions[j] = normalizer.toUnit(glm::clamp(source, low, high));
+                intensities[j] = loadRaw<std::uint16_t>(record + las::kRecordIntensity);
+            }
+            if (!allInBounds) {
+                for (std::size_t j = 0; j < take; ++j) {
+                    const glm::dvec3 source = sourcePosition(records + j * stride, scale, offset);
+                    if (!normalizer.inBounds(source)) {
+                        throwOutOfBounds(normalizer, block.firstIndex + i + j, source);
+                    }
                 }
-                batch.positions.push_back(normalizer.toUnit(glm::clamp(source, low, high)));
-                batch.intensities.push_back(loadRaw<std::uint16_t>(record + las::kRecordIntensity));
             }
             if (hasColor) {
                 for (std::size_t j = 0; j < take; ++j) {
