@@ -229,21 +229,31 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
     const bool hasColor = m_colorDepth != ColorDepth::None;
     const std::size_t stride = m_header.recordLength;
     const LasColumnLayout lasLayout = LasColumnLayout::of(m_info.attributes);
-    // The LAS column is sized for a whole batch up front and each point's bytes are written in
-    // place: appending them point by point cost a library call each (3 % of a LAS build's CPU
-    // time, on the reading thread the whole pipeline waits for).
+    // Every column is sized for a whole batch once and each run of points is written in
+    // place: appending point by point cost a library call or a capacity check each, and
+    // clearing the batch after each delivery had every column zero-filled again before it was
+    // overwritten. `filled` counts the batch's points; only the last batch is cut to it.
     const std::size_t lasBytes = lasLayout.bytes;
     const std::size_t batchCapacity =
         static_cast<std::size_t>(std::min<std::uint64_t>(batchPoints, m_header.pointCount));
-    batch.las.resize(batchCapacity * lasBytes);
-
+    const auto sizeColumns = [&](std::size_t points) {
+        batch.positions.resize(points);
+        batch.intensities.resize(points);
+        if (hasColor) {
+            batch.colors.resize(points);
+        }
+        batch.las.resize(points * lasBytes);
+    };
+    sizeColumns(batchCapacity);
+    std::size_t filled = 0;
     const auto deliver = [&] {
-        batch.las.resize(batch.size() * lasBytes);
+        if (batch.positions.size() != filled) {
+            sizeColumns(filled); // the last batch
+        }
         consumer(batch);
         ++summary.batches;
-        summary.pointsDelivered += batch.size();
-        batch.clear();
-        batch.las.resize(batchCapacity * lasBytes);
+        summary.pointsDelivered += filled;
+        filled = 0;
     };
     // Loop invariants as locals: members read through `this` were reloaded after every store
     // into the batch (the compiler cannot rule out that the stores alias them).
@@ -258,15 +268,15 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
         // The block a batch's worth of records at a time: positions, intensities and colours
         // point by point, then the LAS columns of the run in one call.
         for (std::uint64_t i = 0; i < block.count;) {
-            const std::size_t at = batch.size();
+            const std::size_t at = filled;
             const auto take = static_cast<std::size_t>(
                 std::min<std::uint64_t>(block.count - i, batchPoints - at));
+            if (batch.positions.size() < at + take) {
+                sizeColumns(at + take); // more records than the header declared
+            }
             const std::uint8_t* records = block.records + i * stride;
-            // Written through pointers, the bounds test folded into one flag: a loop without
-            // a branch or a push_back per point. The first point out of bounds is found again
-            // for its error.
-            batch.positions.resize(at + take);
-            batch.intensities.resize(at + take);
+            // The bounds test is folded into one flag per run, so the loop has no branch; the
+            // first point out of bounds is found again for its error.
             glm::vec3* positions = batch.positions.data() + at;
             std::uint16_t* intensities = batch.intensities.data() + at;
             bool allInBounds = true;
@@ -286,15 +296,16 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
                 }
             }
             if (hasColor) {
+                glm::u8vec3* colors = batch.colors.data() + at;
                 for (std::size_t j = 0; j < take; ++j) {
-                    batch.colors.push_back(
-                        color(records + j * stride + colorOffset, sixteenBitColor));
+                    colors[j] = color(records + j * stride + colorOffset, sixteenBitColor);
                 }
             }
             las::readLasColumns(records, take, stride, pointFormat, lasLayout,
                                 batch.las.data() + at * lasBytes);
+            filled += take;
             i += take;
-            if (batch.size() == batchPoints) {
+            if (filled == batchPoints) {
                 deliver();
                 const bool morePoints = block.firstIndex + i < m_header.pointCount;
                 if (morePoints && cancelled()) {
@@ -305,7 +316,7 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
         }
         return true;
     });
-    if (!batch.empty()) {
+    if (filled > 0) {
         deliver();
     }
     return summary;
