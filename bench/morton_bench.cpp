@@ -22,19 +22,11 @@ namespace {
 using omicron::morton::Code;
 using omicron::morton::kMaxLevel;
 
-// Magic-bits variant: shift-and-mask spreading, the usual alternative to a table.
-Code spreadMagic(std::uint32_t v) {
-    Code x = v & 0x1fffffu;
-    x = (x | x << 32) & 0x1f00000000ffffull;
-    x = (x | x << 16) & 0x1f0000ff0000ffull;
-    x = (x | x << 8) & 0x100f00f00f00f00full;
-    x = (x | x << 4) & 0x10c30c30c30c30c3ull;
-    x = (x | x << 2) & 0x1249249249249249ull;
-    return x;
-}
-
 Code encodeMagic(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-    return Code{1} << 63 | spreadMagic(x) | spreadMagic(y) << 1 | spreadMagic(z) << 2;
+    // Magic bits: the shift-and-mask spread, the usual alternative to a table.
+    using omicron::morton::detail::spreadBits3Shifts;
+    return Code{1} << 63 | spreadBits3Shifts(x) | spreadBits3Shifts(y) << 1 |
+           spreadBits3Shifts(z) << 2;
 }
 
 Code encodeLoop(std::uint32_t x, std::uint32_t y, std::uint32_t z) {

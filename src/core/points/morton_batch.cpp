@@ -7,28 +7,6 @@ namespace omicron::morton {
 
 namespace {
 
-// The low 21 bits of v with bit i moved to bit 3*i: five shift-and-mask steps, each a few
-// vector instructions over 64-bit lanes (where the byte table would need gathers).
-inline Code spreadBits3Shifts(std::uint32_t v) {
-    Code x = v & 0x1fffffu;
-    x = (x | x << 32) & 0x1f00000000ffffull;
-    x = (x | x << 16) & 0x1f0000ff0000ffull;
-    x = (x | x << 8) & 0x100f00f00f00f00full;
-    x = (x | x << 4) & 0x10c30c30c30c30c3ull;
-    x = (x | x << 2) & 0x1249249249249249ull;
-    return x;
-}
-
-// quantize() through a signed conversion, which every vector width has: the clamped value is
-// in [0, 2^21 - 1], where it truncates the same.
-inline std::uint32_t quantizeLane(float unit) {
-    const float scaled = unit * static_cast<float>(kCellsPerAxis);
-    const float positive = scaled > 0.0f ? scaled : 0.0f; // NaN compares false -> 0
-    const float lastCell = static_cast<float>(kCellsPerAxis - 1);
-    return static_cast<std::uint32_t>(
-        static_cast<std::int32_t>(positive < lastCell ? positive : lastCell));
-}
-
 // Written once, compiled into each entry point below (the loop is inlined into each, so each
 // gets the vector width of its target).
 [[gnu::always_inline]] inline void encodeLoop(std::span<const glm::vec3> positions,
@@ -38,9 +16,9 @@ inline std::uint32_t quantizeLane(float unit) {
     Code* out = codes.data();
     const std::size_t count = positions.size();
     for (std::size_t i = 0; i < count; ++i) {
-        const Code x = spreadBits3Shifts(quantizeLane(xyz[3 * i]));
-        const Code y = spreadBits3Shifts(quantizeLane(xyz[3 * i + 1]));
-        const Code z = spreadBits3Shifts(quantizeLane(xyz[3 * i + 2]));
+        const Code x = detail::spreadBits3Shifts(quantize(xyz[3 * i]));
+        const Code y = detail::spreadBits3Shifts(quantize(xyz[3 * i + 1]));
+        const Code z = detail::spreadBits3Shifts(quantize(xyz[3 * i + 2]));
         out[i] = (Code{1} << (3 * kMaxLevel)) | x | y << 1 | z << 2;
     }
 }

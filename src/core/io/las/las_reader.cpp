@@ -217,8 +217,6 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
     const std::size_t batchPoints = std::max<std::size_t>(1, options.batchPoints);
     PointBatch batch;
     batch.attributes = m_info.attributes;
-    batch.reserve(
-        static_cast<std::size_t>(std::min<std::uint64_t>(batchPoints, m_header.pointCount)));
 
     // Half a quantisation step: header bounds written from rounded coordinates may miss a
     // point by that much. Points within it are clamped so batches stay inside the cube.
