@@ -163,9 +163,10 @@ int runBuild(const std::vector<std::string>& args) {
     const std::string& path = parsed.positionals[0];
     const MemoryOptions memory = memoryOptions(parsed, parsed.value("save").value_or(""));
     BuildPipeline pipeline;
-    const PipelineResult run = runInterruptibly(
-        pipeline, path,
-        {options, build.sortChunks, build.storage, memory.budgetBytes, memory.tempDir});
+    const PipelineResult run = runInterruptibly(pipeline, path,
+                                                {options, build.sortChunks, build.storage,
+                                                 memory.budgetBytes, memory.tempDir,
+                                                 /*preview=*/false});
     SavedFile saved;
     if (const auto savePath = parsed.value("save")) { // the finished hierarchy, pipeline 3's input
         writeOmh(*savePath, *pipeline.hierarchy(), omhBuildInfo(options, run.stats), saveOptions());

@@ -84,6 +84,7 @@ int runConvert(const std::vector<std::string>& args) {
         SortOptions options;
         options.memoryBudgetBytes = memory.budgetBytes;
         options.tempDir = memory.tempDir;
+        options.previewPoints = 0; // nothing shows it
         sortToOms(inPath, outPath, options);
         std::printf("converted %s to the sorted stream %s\n", inPath.c_str(), outPath.c_str());
         return 0;

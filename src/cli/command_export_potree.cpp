@@ -48,9 +48,10 @@ Source buildHierarchy(const std::string& path, const ParsedArgs& parsed,
                                     static_cast<std::size_t>(build.threads));
     const MemoryOptions memory = memoryOptions(parsed, folder);
     BuildPipeline pipeline;
-    runInterruptibly(
-        pipeline, path,
-        {build.options, build.sortChunks, build.storage, memory.budgetBytes, memory.tempDir});
+    runInterruptibly(pipeline, path,
+                     {build.options, build.sortChunks, build.storage, memory.budgetBytes,
+                      memory.tempDir,
+                      /*preview=*/false});
     return {pipeline.hierarchy(), 0};
 }
 

@@ -66,9 +66,10 @@ std::shared_ptr<const Hierarchy> loadOrBuildHierarchy(const std::string& path,
                                                       const BuildOptions& options,
                                                       const MemoryOptions& memory) {
     BuildPipeline pipeline;
-    runInterruptibly(
-        pipeline, path,
-        {options, kDefaultSortChunks, PointStorage::Exact, memory.budgetBytes, memory.tempDir});
+    runInterruptibly(pipeline, path,
+                     {options, kDefaultSortChunks, PointStorage::Exact, memory.budgetBytes,
+                      memory.tempDir,
+                      /*preview=*/false});
     return pipeline.hierarchy();
 }
 

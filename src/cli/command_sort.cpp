@@ -29,6 +29,7 @@ int runSort(const std::vector<std::string>& args) {
     const MemoryOptions memory = memoryOptions(parsed, outPath);
     options.memoryBudgetBytes = memory.budgetBytes;
     options.tempDir = memory.tempDir;
+    options.previewPoints = 0; // nothing shows it
     const int threads = threadsOption(parsed);
     tbb::global_control threadLimit(tbb::global_control::max_allowed_parallelism,
                                     static_cast<std::size_t>(threads));

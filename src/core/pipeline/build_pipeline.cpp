@@ -285,6 +285,9 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
     sortOptions.storage = options.storage;
     sortOptions.memoryBudgetBytes = options.memoryBudgetBytes;
     sortOptions.tempDir = options.tempDir;
+    if (!options.preview) {
+        sortOptions.previewPoints = 0;
+    }
     auto sorter = std::make_shared<IncrementalMortonSorter>(info, sortOptions);
     PipelineResult result;
     result.pipeline = toString(PipelineKind::UnsortedCloud);
@@ -401,6 +404,9 @@ PipelineResult BuildPipeline::runGeneratedScene(std::uint64_t points, std::uint6
     sortOptions.storage = options.storage;
     sortOptions.memoryBudgetBytes = options.memoryBudgetBytes;
     sortOptions.tempDir = options.tempDir;
+    if (!options.preview) {
+        sortOptions.previewPoints = 0;
+    }
     auto sorter = std::make_shared<IncrementalMortonSorter>(info, sortOptions);
     PipelineResult result;
     result.pipeline = toString(PipelineKind::GeneratedScene);

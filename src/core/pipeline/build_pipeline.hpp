@@ -118,6 +118,11 @@ struct PipelineOptions {
     // least recently used evicted to stay within it (formats/omh_pager.hpp).
     std::uint64_t memoryBudgetBytes = 0;
     std::string tempDir = {};
+    // The random sample of the points read so far that a viewer draws before the first
+    // sorted batch (preview()). Front ends that show nothing while reading turn it off: the
+    // sample costs the sorter's thread, which bounds the read phase, a few draws per point it
+    // takes (12 ms of autzen_south's 72 ms read phase).
+    bool preview = true;
 };
 
 // Points and seed of the built-in default scene when a front end shows it at start-up.

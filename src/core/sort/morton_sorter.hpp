@@ -18,6 +18,7 @@
 #include "io/point_reader.hpp"
 #include "points/page_recycler.hpp"
 #include "points/sorted_cloud.hpp"
+#include "sort/bin_block_pool.hpp"
 #include "sort/preview_sampler.hpp"
 #include "sort/run_spiller.hpp"
 
@@ -123,14 +124,15 @@ private:
     // A bin's input indices in arrival order, in blocks: a growing bin is never reallocated
     // and copied, and holds at most one partly filled block. Codes are not kept: the sort
     // computes them again from the positions, a bin at a time (8 bytes a point less).
+    // The blocks come from m_binBlocks (sort/bin_block_pool.hpp), not the heap.
     static constexpr std::size_t kBinBlock = 4096;
     struct Bin {
-        std::vector<std::unique_ptr<std::uint32_t[]>> blocks;
+        std::vector<std::uint32_t*> blocks;
         std::size_t count = 0;
 
-        void push(std::uint32_t index) {
+        void push(std::uint32_t index, BinBlockPool& pool) {
             if (count % kBinBlock == 0) {
-                blocks.push_back(std::make_unique_for_overwrite<std::uint32_t[]>(kBinBlock));
+                blocks.push_back(static_cast<std::uint32_t*>(pool.allocate()));
             }
             blocks.back()[count % kBinBlock] = index;
             ++count;
@@ -145,6 +147,8 @@ private:
     std::vector<std::vector<std::size_t>>
     blocksDoneAfterChunk(const std::vector<std::size_t>& boundaries) const;
     void releaseInputBlock(std::size_t block);
+    // Gives back the blocks of bins [first, end) (sorted, not read again) and empties them.
+    void releaseBins(std::size_t first, std::size_t end);
     // Backs the untouched pages of the range about to be gathered with given-back input.
     void prepareRecycledPages(const SortedCloud::StagedRange& out);
     int mergeAndEmit(const SortedRangeConsumer& consumer);
@@ -174,6 +178,7 @@ private:
     // Claims [m_populated, end) and faults its pages in (add()'s own batch).
     void populateUpTo(std::size_t end);
     std::size_t m_pagesRecycled = 0;
+    BinBlockPool m_binBlocks{kBinBlock * sizeof(std::uint32_t)}; // outlives m_bins
     std::vector<Bin> m_bins;
     std::vector<std::uint16_t> m_blockLastBin;
     std::vector<morton::Code> m_batchCodes; // scratch for add()

@@ -6,6 +6,7 @@
 #include "pipeline/build_pipeline.hpp"
 #include "test_files.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <gtest/gtest.h>
@@ -193,6 +194,34 @@ TEST(BuildPipeline, ProgressSeenFromAnotherThreadOnlyGrows) {
         EXPECT_LE(b.pointsSorted, b.pointsTotal) << i;
     }
     EXPECT_EQ(samples.back().pointsInserted, 300'000u);
+}
+
+// A front end that draws nothing while reading (the CLI) turns the sorter's preview off: no
+// point is ever sampled, and the hierarchy is the one built with it.
+TEST(BuildPipeline, WithoutAPreviewNothingIsSampledAndTheHierarchyIsTheSame) {
+    BuildPipeline withPreview;
+    const PipelineResult reference = withPreview.runGeneratedScene(300'000, 7, smallOptions(7));
+
+    BuildPipeline pipeline;
+    PipelineOptions options = smallOptions(7);
+    options.preview = false;
+    std::atomic<bool> done{false};
+    std::size_t largestPreview = 0;
+    std::size_t polls = 0;
+    std::thread poller([&] {
+        while (!done.load()) {
+            largestPreview = std::max(largestPreview, pipeline.preview().positions.size());
+            ++polls;
+            std::this_thread::sleep_for(std::chrono::microseconds(100));
+        }
+    });
+    const PipelineResult result = pipeline.runGeneratedScene(300'000, 7, options);
+    done.store(true);
+    poller.join();
+    EXPECT_GT(polls, 0u);
+    EXPECT_EQ(largestPreview, 0u);
+    EXPECT_TRUE(result.stats.complete);
+    expectSameLevels(reference.stats, result.stats);
 }
 
 TEST(BuildPipeline, CancelStopsARunPromptly) {
