@@ -170,6 +170,7 @@ private:
         }
     }
 
+    // keepLength's loop for a span's last bytes (nextByte counts those it lacks).
     void renormalize() {
         do {
             m_value = (m_value << 8) | nextByte();
