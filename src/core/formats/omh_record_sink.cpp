@@ -125,12 +125,6 @@ void encodeRecords(const SortedCloud& cloud, const omh::RecordLayout& layout,
             cloud, layout, [begin](std::uint32_t p) { return begin + p; }, splats, first, last,
             out);
     }
-    if (node.sampleIndices != nullptr) {
-        const std::uint32_t* const indices = node.sampleIndices;
-        return encodeExactRecords<LasBytes>(
-            cloud, layout, [indices](std::uint32_t p) { return indices[p]; }, splats, first, last,
-            out);
-    }
     encodeExactRecords<LasBytes>(
         cloud, layout, [&node](std::uint32_t p) { return node.heldPoint(p); }, splats, first, last,
         out);

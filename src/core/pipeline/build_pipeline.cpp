@@ -27,6 +27,20 @@ void copySlice(const PointBatch& from, std::size_t begin, std::size_t end, Point
     to.appendRange(from, begin, end);
 }
 
+// The sorter's options for a run of pipeline 1 (a cloud file or the generated scene).
+SortOptions sortOptionsOf(const PipelineOptions& options, const std::atomic<bool>& cancel) {
+    SortOptions sortOptions;
+    sortOptions.chunks = options.sortChunks;
+    sortOptions.cancel = &cancel;
+    sortOptions.storage = options.storage;
+    sortOptions.memoryBudgetBytes = options.memoryBudgetBytes;
+    sortOptions.tempDir = options.tempDir;
+    if (!options.preview) {
+        sortOptions.previewPoints = 0;
+    }
+    return sortOptions;
+}
+
 std::string describeCloud(const CloudInfo& info) {
     std::string text = info.formatDetail.empty() ? toString(info.format) : info.formatDetail;
     return text + ", " + std::to_string(info.pointCount) + " points";
@@ -279,15 +293,7 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
         return result;
     }
     const CloudInfo& info = reader->info();
-    SortOptions sortOptions;
-    sortOptions.chunks = options.sortChunks;
-    sortOptions.cancel = &m_cancel;
-    sortOptions.storage = options.storage;
-    sortOptions.memoryBudgetBytes = options.memoryBudgetBytes;
-    sortOptions.tempDir = options.tempDir;
-    if (!options.preview) {
-        sortOptions.previewPoints = 0;
-    }
+    const SortOptions sortOptions = sortOptionsOf(options, m_cancel);
     auto sorter = std::make_shared<IncrementalMortonSorter>(info, sortOptions);
     PipelineResult result;
     result.pipeline = toString(PipelineKind::UnsortedCloud);
@@ -398,15 +404,7 @@ PipelineResult BuildPipeline::runGeneratedScene(std::uint64_t points, std::uint6
     info.sourceBounds = scene.sourceBounds;
     info.boundsFromHeader = true;
     info.cube = scene.cube;
-    SortOptions sortOptions;
-    sortOptions.chunks = options.sortChunks;
-    sortOptions.cancel = &m_cancel;
-    sortOptions.storage = options.storage;
-    sortOptions.memoryBudgetBytes = options.memoryBudgetBytes;
-    sortOptions.tempDir = options.tempDir;
-    if (!options.preview) {
-        sortOptions.previewPoints = 0;
-    }
+    const SortOptions sortOptions = sortOptionsOf(options, m_cancel);
     auto sorter = std::make_shared<IncrementalMortonSorter>(info, sortOptions);
     PipelineResult result;
     result.pipeline = toString(PipelineKind::GeneratedScene);

@@ -2,6 +2,7 @@
 
 #include "points/huge_page_buffer.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <new>
 #include <sys/mman.h>
@@ -42,8 +43,17 @@ void* BinBlockPool::allocate() {
     return block;
 }
 
-void BinBlockPool::release(void* first, std::size_t count) const {
-    releasePages(first, count * m_blockBytes);
+void BinBlockPool::release(std::vector<void*> blocks) const {
+    std::sort(blocks.begin(), blocks.end());
+    for (std::size_t i = 0; i < blocks.size();) {
+        std::size_t end = i + 1;
+        while (end < blocks.size() &&
+               blocks[end] == static_cast<std::byte*>(blocks[end - 1]) + m_blockBytes) {
+            ++end;
+        }
+        releasePages(blocks[i], (end - i) * m_blockBytes);
+        i = end;
+    }
 }
 
 } // namespace omicron

@@ -292,25 +292,12 @@ void IncrementalMortonSorter::releaseInputBlock(std::size_t block) {
 }
 
 void IncrementalMortonSorter::releaseBins(std::size_t first, std::size_t end) {
-    // Blocks adjacent in memory (taken one after the other while reading, often by bins of one
-    // region) go back in one call: each call interrupts the other cores to flush their TLBs,
-    // and a call per block made the sort 30 ms slower on 24.2 M points.
-    std::vector<std::uint32_t*> blocks;
+    std::vector<void*> blocks;
     for (std::size_t bin = first; bin < end; ++bin) {
         blocks.insert(blocks.end(), m_bins[bin].blocks.begin(), m_bins[bin].blocks.end());
         m_bins[bin] = Bin{};
     }
-    std::sort(blocks.begin(), blocks.end());
-    const std::size_t blockBytes = m_binBlocks.blockBytes();
-    for (std::size_t i = 0; i < blocks.size();) {
-        std::size_t j = i + 1;
-        while (j < blocks.size() && reinterpret_cast<std::byte*>(blocks[j]) ==
-                                        reinterpret_cast<std::byte*>(blocks[j - 1]) + blockBytes) {
-            ++j;
-        }
-        m_binBlocks.release(blocks[i], j - i);
-        i = j;
-    }
+    m_binBlocks.release(std::move(blocks));
 }
 
 void IncrementalMortonSorter::prepareRecycledPages(const SortedCloud::StagedRange& out) {

@@ -63,10 +63,10 @@ TEST(BinBlockPool, ReleasedBlocksGiveTheirPagesBackAndOthersKeepTheirs) {
     }
     ASSERT_EQ(blocks[1], blocks[0] + kBlockBytes); // one slab: adjacent
     ASSERT_EQ(blocks[2], blocks[1] + kBlockBytes);
-    pool.release(blocks[1], 2); // two adjacent blocks in one call
+    pool.release({blocks[1], blocks[2]}); // two adjacent blocks: one call
     EXPECT_EQ(residentPages(blocks[1]), 0u);
     EXPECT_EQ(residentPages(blocks[2]), 0u);
-    pool.release(blocks[3]);
+    pool.release({blocks[3]});
     EXPECT_EQ(residentPages(blocks[3]), 0u);
     EXPECT_EQ(residentPages(blocks[0]), kBlockBytes / 4096);
     for (std::size_t i = 0; i < kBlockBytes; ++i) {
