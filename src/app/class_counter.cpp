@@ -65,8 +65,6 @@ void ClassCounter::run(std::stop_token stop, std::shared_ptr<const Hierarchy> hi
 
 // A sorted cloud holds each input point once, published as a growing prefix.
 void ClassCounter::countPrefix(std::stop_token stop, const SortedCloud& cloud) {
-    const AttributeSet attributes = cloud.attributes();
-    const std::size_t stride = attributes.lasBytes();
     std::array<std::uint64_t, kLasClassCount> counts{};
     std::size_t counted = 0;
     while (!stop.stop_requested()) {
@@ -74,12 +72,15 @@ void ClassCounter::countPrefix(std::stop_token stop, const SortedCloud& cloud) {
         const std::size_t published = cloud.sortedEnd();
         if (counted < published) {
             const std::size_t end = std::min(published, counted + kChunkPoints);
-            if (stride == 0) {
+            // Read once a range is published: a uniform column is declared before that.
+            const ColumnView<std::uint8_t> las = cloud.lasColumn();
+            if (las.empty()) {
                 counts[0] += end - counted; // no LAS column: every point is class 0
+            } else if (las.stride == 0) {
+                counts[las.data[0]] += end - counted; // uniform: one record for every point
             } else {
-                const std::uint8_t* column = cloud.lasColumn().data();
                 for (std::size_t i = counted; i < end; ++i) {
-                    ++counts[column[i * stride]]; // the classification is the column's byte 0
+                    ++counts[las[i]]; // the classification is the record's byte 0
                 }
             }
             counted = end;

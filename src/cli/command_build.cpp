@@ -94,21 +94,22 @@ void printJson(const PipelineResult& run, const BuildOptions& options, const Sav
 // together (about 40 ms on two cores), and what is left to unmap is cheap. The cloud reads as
 // zeros afterwards (a file-backed one from its file): call it when nothing reads it again.
 void dropCloudPagesOnAllCores(const SortedCloud& cloud) {
-    const auto drop = [](const auto& array) {
+    const auto drop = [](const void* data, std::size_t size) {
         constexpr std::size_t kSliceBytes = std::size_t{8} << 20;
-        const auto* bytes = reinterpret_cast<const std::uint8_t*>(array.data());
-        const std::size_t size = array.size_bytes();
+        const auto* bytes = static_cast<const std::uint8_t*>(data);
         tbb::parallel_for(std::size_t{0}, (size + kSliceBytes - 1) / kSliceBytes,
                           [&](std::size_t slice) {
                               const std::size_t begin = slice * kSliceBytes;
                               releasePages(bytes + begin, std::min(kSliceBytes, size - begin));
                           });
     };
-    drop(cloud.positions());
-    drop(cloud.normals());
-    drop(cloud.colors());
-    drop(cloud.intensities());
-    drop(cloud.lasColumn());
+    drop(cloud.positions().data(), cloud.positions().size_bytes());
+    drop(cloud.normals().data(), cloud.normals().size_bytes());
+    drop(cloud.colors().data(), cloud.colors().size_bytes());
+    // A uniform column (stride 0) holds one value: nothing worth giving back.
+    drop(cloud.intensities().data,
+         cloud.capacity() * cloud.intensities().stride * sizeof(std::uint16_t));
+    drop(cloud.lasColumn().data, cloud.capacity() * cloud.lasColumn().stride);
 }
 
 void printText(const PipelineResult& run, const BuildOptions& options, const SavedFile& saved) {

@@ -73,10 +73,13 @@ void encodeExactRecords(const SortedCloud& cloud, const omh::RecordLayout& layou
         attributes.has(Attribute::Normal) ? cloud.normals().data() : nullptr;
     const glm::u8vec3* const colors =
         attributes.has(Attribute::Color) ? cloud.colors().data() : nullptr;
+    // Intensities and LAS records by their stride: 0 for a uniform column.
     const std::uint16_t* const intensities =
-        attributes.has(Attribute::Intensity) ? cloud.intensities().data() : nullptr;
+        attributes.has(Attribute::Intensity) ? cloud.intensities().data : nullptr;
+    const std::size_t intensityStride = cloud.intensities().stride;
     const std::size_t lasBytes = LasBytes != 0 ? LasBytes : layout.point.lasBytes;
-    const std::uint8_t* const las = lasBytes != 0 ? cloud.lasColumn().data() : nullptr;
+    const std::uint8_t* const las = lasBytes != 0 ? cloud.lasColumn().data : nullptr;
+    const std::size_t lasStride = cloud.lasColumn().stride;
     const std::uint16_t* const radii = splats.radii.data();
     const std::uint32_t* const estimated = splats.normals.empty() ? nullptr : splats.normals.data();
     const std::size_t recordBytes = layout.bytes;
@@ -96,10 +99,10 @@ void encodeExactRecords(const SortedCloud& cloud, const omh::RecordLayout& layou
             storeRaw(out + colorOffset, colors[index]);
         }
         if (intensities != nullptr) {
-            storeRaw(out + intensityOffset, intensities[index]);
+            storeRaw(out + intensityOffset, intensities[index * intensityStride]);
         }
         if (las != nullptr) {
-            std::memcpy(out + lasOffset, las + index * lasBytes, lasBytes);
+            std::memcpy(out + lasOffset, las + index * lasStride, lasBytes);
         }
         storeRaw(out + radiusOffset, radii[p]);
         if (estimatedOffset != 0) {

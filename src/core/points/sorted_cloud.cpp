@@ -1,5 +1,6 @@
 #include "points/sorted_cloud.hpp"
 
+#include <cstring>
 #include <stdexcept>
 
 namespace omicron {
@@ -75,6 +76,20 @@ SortedCloud::InPlaceArrays SortedCloud::inPlaceArrays() {
             bytes(m_las)};
 }
 
+void SortedCloud::setUniformColumns(const std::uint16_t* intensity, const std::uint8_t* lasRecord) {
+    assert(m_sortedEnd.load(std::memory_order_relaxed) == 0 && !fileBacked() && !pagedOnDemand());
+    if (intensity != nullptr) {
+        assert(m_intensities.size() != 0);
+        m_intensities.data()[0] = *intensity;
+        m_intensityStride = 0;
+    }
+    if (lasRecord != nullptr) {
+        assert(m_las.size() != 0);
+        std::memcpy(m_las.data(), lasRecord, m_attributes.lasBytes());
+        m_lasStride = 0;
+    }
+}
+
 SortedCloud::StagedRange SortedCloud::stage(std::size_t end) {
     const std::size_t begin = m_sortedEnd.load(std::memory_order_relaxed);
     assert(begin <= end && end <= m_capacity);
@@ -84,10 +99,12 @@ SortedCloud::StagedRange SortedCloud::stage(std::size_t end) {
                                  : std::span(array.data() + begin, count);
     };
     const std::size_t lasBytes = m_attributes.lasBytes();
-    StagedRange staged{
-        inPlace(m_positions), inPlace(m_normals), inPlace(m_colors), inPlace(m_intensities),
-        lasBytes == 0 ? std::span<std::uint8_t>()
-                      : std::span(m_las.data() + begin * lasBytes, count * lasBytes)};
+    // A uniform column is not staged: its one value is stored already.
+    StagedRange staged{inPlace(m_positions), inPlace(m_normals), inPlace(m_colors),
+                       m_intensityStride == 0 ? std::span<std::uint16_t>() : inPlace(m_intensities),
+                       lasBytes == 0 || m_lasStride == 0
+                           ? std::span<std::uint8_t>()
+                           : std::span(m_las.data() + begin * lasBytes, count * lasBytes)};
     if (m_packed) {
         m_stagedPositions.resize(count);
         staged.positions = m_stagedPositions;
@@ -171,9 +188,10 @@ void SortedCloud::markComplete() {
 }
 
 std::size_t SortedCloud::bytesResident() const {
-    const std::size_t arrays = positions().size_bytes() + normals().size_bytes() +
-                               colors().size_bytes() + intensities().size_bytes() +
-                               lasColumn().size_bytes();
+    // A uniform column holds one value (on one page, counted as nothing).
+    const std::size_t arrays =
+        positions().size_bytes() + normals().size_bytes() + colors().size_bytes() +
+        m_intensities.size() * m_intensityStride * sizeof(std::uint16_t) + m_capacity * m_lasStride;
     return (fileBacked() ? 0 : arrays) + m_blockCodes.size() * sizeof(morton::Code) +
            (m_packed ? m_packed->bytesResident() : 0);
 }
@@ -216,9 +234,20 @@ void SortedCloud::copyRange(std::size_t begin, std::size_t end, PointBatch& out)
         }
     };
     copyInto(normals(), out.normals);
-    copyInto(intensities(), out.intensities);
     const std::size_t lasBytes = m_attributes.lasBytes();
-    out.las.assign(m_las.data() + begin * lasBytes, m_las.data() + end * lasBytes);
+    if (m_intensityStride != 0 || m_intensities.size() == 0) {
+        copyInto(std::span<const std::uint16_t>(m_intensities), out.intensities);
+    } else { // uniform
+        out.intensities.assign(end - begin, m_intensities.data()[0]);
+    }
+    if (m_lasStride != 0 || lasBytes == 0) {
+        out.las.assign(m_las.data() + begin * lasBytes, m_las.data() + end * lasBytes);
+    } else { // uniform
+        out.las.resize((end - begin) * lasBytes);
+        for (std::size_t i = 0; i < end - begin; ++i) {
+            std::memcpy(out.las.data() + i * lasBytes, m_las.data(), lasBytes);
+        }
+    }
 }
 
 } // namespace omicron

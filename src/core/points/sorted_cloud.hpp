@@ -60,6 +60,16 @@ const char* toString(PointStorage storage);
 // "exact" or "packed"; false for anything else.
 bool parsePointStorage(std::string_view text, PointStorage& out);
 
+// A column of a cloud: point i's value is data[i * stride]. The stride is 0 for a uniform
+// column (one value for every point, stored once); data is null when the cloud lacks it.
+template <typename T> struct ColumnView {
+    const T* data = nullptr;
+    std::size_t stride = 0; // elements (bytes for the LAS column: a whole record)
+
+    bool empty() const { return data == nullptr; }
+    const T& operator[](std::size_t i) const { return data[i * stride]; }
+};
+
 class SortedCloud {
 public:
     SortedCloud(const CubeTransform& cube, const glm::dvec3& sourceOffset, AttributeSet attributes,
@@ -116,13 +126,23 @@ public:
     std::span<const glm::u8vec3> colors() const { return m_colors; }
     // Either store keeps these as read.
     std::span<const glm::vec3> normals() const { return m_normals; }
-    std::span<const std::uint16_t> intensities() const { return m_intensities; }
-    // The LAS column (points/las_fields.hpp), attributes().lasBytes() bytes a point; empty
-    // without Attribute::Las.
-    std::span<const std::uint8_t> lasColumn() const { return m_las; }
-    const std::uint8_t* lasRecord(std::size_t i) const {
-        return m_las.data() + i * m_attributes.lasBytes();
+    // Intensities, and the LAS column (points/las_fields.hpp, attributes().lasBytes() bytes a
+    // point): empty without their attribute; uniform (stride 0) when every point shares the
+    // first point's value, which is then stored once (setUniformColumns()).
+    ColumnView<std::uint16_t> intensities() const {
+        return {m_intensities.size() == 0 ? nullptr : m_intensities.data(), m_intensityStride};
     }
+    ColumnView<std::uint8_t> lasColumn() const {
+        return {m_las.size() == 0 ? nullptr : m_las.data(), m_lasStride};
+    }
+    const std::uint8_t* lasRecord(std::size_t i) const { return m_las.data() + i * m_lasStride; }
+    // Producer side, before the first stage(): the intensities and/or the LAS column are the
+    // same for every point, `intensity` and `lasRecord` (lasBytes() bytes): each is stored
+    // once, and stage() hands out no span for it. An in-memory cloud only (not file-backed or
+    // paged), with the attribute.
+    void setUniformColumns(const std::uint16_t* intensity, const std::uint8_t* lasRecord);
+    bool uniformIntensities() const { return m_intensities.size() != 0 && m_intensityStride == 0; }
+    bool uniformLasColumn() const { return m_las.size() != 0 && m_lasStride == 0; }
     // What the LAS column's extra bytes are (the source's Extra Bytes descriptors, 192 bytes
     // each), for a LAS export; empty when unknown. Set by the producer before it publishes.
     const std::vector<std::uint8_t>& lasExtraBytesDescriptors() const {
@@ -216,6 +236,9 @@ private:
     HugePageArray<glm::u8vec3> m_colors;
     HugePageArray<std::uint16_t> m_intensities;
     HugePageArray<std::uint8_t> m_las;
+    // 1, or 0: uniform (only element 0 is stored) or no intensities.
+    std::size_t m_intensityStride = m_attributes.has(Attribute::Intensity) ? 1 : 0;
+    std::size_t m_lasStride = m_attributes.lasBytes(); // or 0: uniform (record 0 only)
     std::vector<std::uint8_t> m_extraBytesDescriptors;
     std::vector<std::uint8_t> m_projectionRecords;
     HugePageArray<morton::Code> m_blockCodes;   // CloudOrder::Morton only

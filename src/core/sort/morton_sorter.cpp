@@ -108,6 +108,8 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
     if (spills) {
         return;
     }
+    m_uniform[kIntensities] = info.attributes.has(Attribute::Intensity);
+    m_uniform[kLas] = info.attributes.lasBytes() != 0;
     m_bins.resize(kBins);
     m_blockLastBin.assign((capacity >> kReleaseBlockBits) + 1, 0);
     m_input.reserve(capacity);
@@ -182,13 +184,66 @@ void IncrementalMortonSorter::add(const PointBatch& batch, std::span<const morto
     // The arrival arrays are reserved for the whole cloud and filled batch by batch: the
     // batch's new pages are faulted in by one call per array before the copy, unless
     // populateAhead() has claimed them already.
+    checkUniformColumns(batch, firstIndex);
     populateUpTo(firstIndex + count);
-    m_input.append(batch);
+    appendArrival(batch);
+}
+
+void IncrementalMortonSorter::checkUniformColumns(const PointBatch& batch, std::size_t firstIndex) {
+    if (batch.empty()) {
+        return;
+    }
+    if (m_uniform[kIntensities].load(std::memory_order_relaxed)) {
+        const std::vector<std::uint16_t>& values = batch.intensities;
+        if (firstIndex == 0) {
+            m_uniformIntensity = values[0];
+        }
+        if (!std::all_of(values.begin(), values.end(),
+                         [&](std::uint16_t v) { return v == m_uniformIntensity; })) {
+            m_uniform[kIntensities].store(false, std::memory_order_relaxed);
+            m_input.intensities.assign(firstIndex, m_uniformIntensity);
+        }
+    }
+    if (m_uniform[kLas].load(std::memory_order_relaxed)) {
+        const std::size_t bytes = m_input.attributes.lasBytes();
+        const std::vector<std::uint8_t>& records = batch.las;
+        if (firstIndex == 0) {
+            m_uniformLasRecord.assign(records.begin(), records.begin() + bytes);
+        }
+        // Every record equals the first when the column repeats with a period of one record.
+        const bool same =
+            std::memcmp(records.data(), m_uniformLasRecord.data(), bytes) == 0 &&
+            std::memcmp(records.data() + bytes, records.data(), records.size() - bytes) == 0;
+        if (!same) {
+            m_uniform[kLas].store(false, std::memory_order_relaxed);
+            m_input.las.resize(firstIndex * bytes);
+            for (std::size_t i = 0; i < firstIndex; ++i) {
+                std::memcpy(m_input.las.data() + i * bytes, m_uniformLasRecord.data(), bytes);
+            }
+        }
+    }
+}
+
+void IncrementalMortonSorter::appendArrival(const PointBatch& batch) {
+    const auto append = [](auto& to, const auto& from) {
+        to.insert(to.end(), from.begin(), from.end());
+    };
+    append(m_input.positions, batch.positions);
+    append(m_input.normals, batch.normals);
+    append(m_input.colors, batch.colors);
+    if (!m_uniform[kIntensities].load(std::memory_order_relaxed)) {
+        append(m_input.intensities, batch.intensities);
+    }
+    if (!m_uniform[kLas].load(std::memory_order_relaxed)) {
+        append(m_input.las, batch.las);
+    }
 }
 
 void IncrementalMortonSorter::populateArrival(std::size_t begin, std::size_t end) const {
-    for (const ArrivalColumn& column : m_arrivalColumns) {
-        if (column.base != nullptr && column.pointBytes != 0) {
+    for (std::size_t c = 0; c < kColumns; ++c) {
+        const ArrivalColumn& column = m_arrivalColumns[c];
+        if (column.base != nullptr && column.pointBytes != 0 &&
+            !m_uniform[c].load(std::memory_order_relaxed)) {
             populatePages(column.base + begin * column.pointBytes,
                           (end - begin) * column.pointBytes);
         }
@@ -336,6 +391,20 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
         largestChunk = std::max(largestChunk, size);
     }
 
+    // A column uniform to the end is stored once, and not gathered.
+    const bool uniformIntensities = m_pointsAdded != 0 && m_uniform[kIntensities].load();
+    const bool uniformLas = m_pointsAdded != 0 && m_uniform[kLas].load();
+    if (uniformIntensities || uniformLas) {
+        m_cloud->setUniformColumns(uniformIntensities ? &m_uniformIntensity : nullptr,
+                                   uniformLas ? m_uniformLasRecord.data() : nullptr);
+        if (uniformIntensities) {
+            m_recyclers[kIntensities].reset();
+        }
+        if (uniformLas) {
+            m_recyclers[kLas].reset();
+        }
+    }
+
     std::vector<std::uint64_t> keys(largestChunk), keyScratch(largestChunk);
     std::vector<std::uint32_t> indices(largestChunk), indexScratch(largestChunk);
     SortedCloud& cloud = *m_cloud;
@@ -410,7 +479,7 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                                                  out.intensities[i] = m_input.intensities[from];
                                              }
                                          }
-                                         if (lasBytes != 0) {
+                                         if (!m_input.las.empty()) {
                                              gatherColumn(out.las.data(), m_input.las.data(),
                                                           indices.data(), range.begin(),
                                                           range.end(), lasBytes);

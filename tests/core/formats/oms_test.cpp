@@ -104,12 +104,17 @@ void expectSameCloud(const SortedCloud& expected, const SortedCloud& got) {
     EXPECT_TRUE(expected.normals().empty() || sameBits(expected.normals(), got.normals(), n));
     EXPECT_EQ(got.colors().size(), expected.colors().size());
     EXPECT_TRUE(expected.colors().empty() || sameBits(expected.colors(), got.colors(), n));
-    EXPECT_EQ(got.intensities().size(), expected.intensities().size());
-    EXPECT_TRUE(expected.intensities().empty() ||
-                sameBits(expected.intensities(), got.intensities(), n));
-    EXPECT_EQ(got.lasColumn().size(), expected.lasColumn().size());
-    EXPECT_TRUE(std::equal(expected.lasColumn().begin(), expected.lasColumn().end(),
-                           got.lasColumn().begin(), got.lasColumn().end()));
+    EXPECT_EQ(got.intensities().empty(), expected.intensities().empty());
+    EXPECT_EQ(got.lasColumn().empty(), expected.lasColumn().empty());
+    const std::size_t lasBytes = expected.attributes().lasBytes();
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!expected.intensities().empty()) {
+            ASSERT_EQ(got.intensities()[i], expected.intensities()[i]) << i;
+        }
+        if (lasBytes != 0) {
+            ASSERT_EQ(std::memcmp(got.lasRecord(i), expected.lasRecord(i), lasBytes), 0) << i;
+        }
+    }
 }
 
 // What the consumer saw, call by call.

@@ -1,0 +1,150 @@
+// Uniform columns: intensities or a LAS column that hold one value for every point are not
+// copied into the sorter's arrival arrays and are stored once in the sorted cloud; a column that
+// stops being uniform at any point (first batch, a batch boundary, mid-batch, the last point)
+// becomes an ordinary one, and every point keeps its own value either way.
+#include "sort/morton_sorter.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+#include <gtest/gtest.h>
+#include <random>
+#include <thread>
+#include <vector>
+
+namespace omicron {
+namespace {
+
+constexpr std::size_t kPoints = 50000;
+constexpr std::size_t kFeedBatch = 4096;
+
+// Normal, intensity and a LAS column with GPS time (16 bytes); normal.z is the input index.
+struct Input {
+    CloudInfo info;
+    PointBatch points;
+};
+
+// Every intensity is 7 and every LAS record the same pattern, except the point at
+// `intensityChangesAt` / `lasChangesAt` and after it (kPoints: never).
+Input makeInput(std::size_t intensityChangesAt, std::size_t lasChangesAt) {
+    Input input;
+    input.info.path = "synthetic";
+    input.info.pointCount = kPoints;
+    input.info.attributes = AttributeSet(Attribute::Normal) | Attribute::Intensity |
+                            Attribute::Las | Attribute::GpsTime;
+    input.points.attributes = input.info.attributes;
+    const std::size_t lasBytes = input.info.attributes.lasBytes();
+    std::mt19937_64 random(42);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    for (std::size_t i = 0; i < kPoints; ++i) {
+        input.points.positions.emplace_back(unit(random), unit(random), unit(random));
+        input.points.normals.emplace_back(0.0f, 0.0f, float(i));
+        input.points.intensities.push_back(
+            i < intensityChangesAt ? 7 : static_cast<std::uint16_t>(random()));
+        for (std::size_t b = 0; b < lasBytes; ++b) {
+            input.points.las.push_back(i < lasChangesAt ? static_cast<std::uint8_t>(b * 3 + 1)
+                                                        : static_cast<std::uint8_t>(random()));
+        }
+    }
+    return input;
+}
+
+// Sorts `input` fed in batches of kFeedBatch, with another thread faulting arrival pages in
+// ahead (as the reader does), and checks every point's attributes against its input point.
+std::shared_ptr<const SortedCloud> sortAndCheck(const Input& input) {
+    SortOptions options;
+    options.chunks = 4;
+    IncrementalMortonSorter sorter(input.info, options);
+    std::atomic<std::size_t> added{0};
+    std::atomic<bool> reading{true};
+    std::thread populator([&] {
+        while (reading.load()) {
+            if (!sorter.populateAhead(added.load() + 2 * kFeedBatch)) {
+                std::this_thread::yield();
+            }
+        }
+    });
+    const std::size_t lasBytes = input.info.attributes.lasBytes();
+    for (std::size_t begin = 0; begin < kPoints; begin += kFeedBatch) {
+        const std::size_t end = std::min(kPoints, begin + kFeedBatch);
+        PointBatch batch;
+        batch.attributes = input.points.attributes;
+        batch.appendRange(input.points, begin, end);
+        sorter.add(batch);
+        added = end;
+    }
+    reading = false;
+    populator.join();
+    sorter.sortAndEmit([](const SortedCloud&, std::size_t, std::size_t) {});
+    const auto sorted = sorter.cloud();
+    EXPECT_TRUE(sorted->complete());
+    EXPECT_EQ(sorted->sortedEnd(), kPoints);
+    std::vector<bool> seen(kPoints, false);
+    for (std::size_t i = 0; i < sorted->sortedEnd(); ++i) {
+        const auto from = static_cast<std::size_t>(sorted->normals()[i].z);
+        EXPECT_FALSE(seen[from]);
+        seen[from] = true;
+        EXPECT_EQ(sorted->positions()[i], input.points.positions[from]);
+        EXPECT_EQ(sorted->intensities()[i], input.points.intensities[from]) << i;
+        EXPECT_EQ(
+            std::memcmp(sorted->lasRecord(i), input.points.las.data() + from * lasBytes, lasBytes),
+            0)
+            << i;
+    }
+    return sorted;
+}
+
+// The bytes a cloud of kPoints keeps for a column of `bytes` bytes a point.
+constexpr std::size_t columnBytes(std::size_t bytes) {
+    return kPoints * bytes;
+}
+
+TEST(UniformColumns, OneValueForEveryPointIsStoredOnce) {
+    const auto uniform = sortAndCheck(makeInput(kPoints, kPoints));
+    EXPECT_TRUE(uniform->uniformIntensities());
+    EXPECT_TRUE(uniform->uniformLasColumn());
+    EXPECT_EQ(uniform->intensities().stride, 0u);
+    EXPECT_EQ(uniform->lasColumn().stride, 0u);
+
+    const auto ordinary = sortAndCheck(makeInput(0, 0));
+    EXPECT_FALSE(ordinary->uniformIntensities());
+    EXPECT_FALSE(ordinary->uniformLasColumn());
+    EXPECT_EQ(ordinary->bytesResident() - uniform->bytesResident(),
+              columnBytes(sizeof(std::uint16_t)) + columnBytes(16));
+}
+
+TEST(UniformColumns, AColumnThatChangesAnywhereKeepsEveryValue) {
+    // The second point, the first point of a later batch, mid-batch, the last point.
+    for (const std::size_t at :
+         {std::size_t{1}, 3 * kFeedBatch, 5 * kFeedBatch + 17, kPoints - 1}) {
+        SCOPED_TRACE(at);
+        const auto intensitiesChange = sortAndCheck(makeInput(at, kPoints));
+        EXPECT_FALSE(intensitiesChange->uniformIntensities());
+        EXPECT_TRUE(intensitiesChange->uniformLasColumn());
+
+        const auto lasChanges = sortAndCheck(makeInput(kPoints, at));
+        EXPECT_TRUE(lasChanges->uniformIntensities());
+        EXPECT_FALSE(lasChanges->uniformLasColumn());
+    }
+}
+
+TEST(UniformColumns, ASpillingSortKeepsOrdinaryColumns) {
+    const Input input = makeInput(kPoints, kPoints);
+    SortOptions options;
+    options.memoryBudgetBytes = 256 * 1024; // far below the in-memory sort: runs on disk
+    IncrementalMortonSorter sorter(input.info, options);
+    ASSERT_TRUE(sorter.spills());
+    sorter.add(input.points);
+    sorter.sortAndEmit([](const SortedCloud&, std::size_t, std::size_t) {});
+    const auto sorted = sorter.cloud();
+    ASSERT_EQ(sorted->sortedEnd(), kPoints);
+    EXPECT_FALSE(sorted->uniformIntensities());
+    EXPECT_FALSE(sorted->uniformLasColumn());
+    for (std::size_t i = 0; i < kPoints; ++i) {
+        ASSERT_EQ(sorted->intensities()[i], 7);
+        ASSERT_EQ(sorted->lasRecord(i)[15], 15 * 3 + 1);
+    }
+}
+
+} // namespace
+} // namespace omicron
