@@ -113,6 +113,19 @@ private slots:
         QCOMPARE(counter.snapshot().total, quint64(0));
     }
 
+    void aUniformLasColumnCountsEveryPointInItsClass() {
+        QTemporaryDir dir;
+        const QString path = dir.filePath(QStringLiteral("one_class.las"));
+        test::writeClassifiedLas(path, true);
+        const auto hierarchy = test::buildHierarchy(path, BuildOptions{});
+        QVERIFY(hierarchy->cloud().uniformLasColumn()); // stored once, read for every point
+        ClassesPanel panel;
+        panel.setHierarchy(hierarchy);
+        QTRY_VERIFY(panel.counts().complete);
+        QCOMPARE(panel.model()->classes(), (std::vector<int>{6}));
+        QCOMPARE(panel.model()->count(6), quint64(2 * test::kClassifiedLasPointsPerClass));
+    }
+
     void sharedTerraScanTileCountsEveryClass() {
         OMICRON_REQUIRE_SHARED_FILE(path, QStringLiteral("laz/terrascan_fmt8.laz"));
         ClassesPanel panel;

@@ -98,6 +98,27 @@ private slots:
                                 .arg(covered)));
     }
 
+    // Every LAS record the same: the sorted cloud stores the column once, and every point
+    // still draws in its class's colour.
+    void aCloudOfOneClassDrawsInItsColour() {
+        QTemporaryDir dir;
+        const QString path = dir.filePath(QStringLiteral("one_class.las"));
+        test::writeClassifiedLas(path, true);
+        const auto hierarchy = test::buildHierarchy(path, BuildOptions{});
+        QVERIFY(hierarchy->cloud().uniformLasColumn());
+        CloudView view;
+        view.setHierarchy(hierarchy);
+        view.setStandardView(StandardView::Top);
+        const QImage image =
+            render(view, plainSettings(RenderMode::ComputePoints, ColorMode::Classification));
+        const int building = test::pixelsNear(image, classColor(6));
+        const int covered =
+            static_cast<int>(test::coverage(image, test::viewBackground()) * 400 * 400);
+        QVERIFY2(covered > 0 && building > covered * 9 / 10,
+                 qPrintable(QStringLiteral("building %1 covered %2").arg(building).arg(covered)));
+        QCOMPARE(test::pixelsNear(image, classColor(2)), 0);
+    }
+
     void hidingAClassRemovesExactlyItsPixels_data() { renderModes(); }
     void hidingAClassRemovesExactlyItsPixels() {
         QFETCH(RenderMode, mode);

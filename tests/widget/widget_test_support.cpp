@@ -87,7 +87,7 @@ int pixelsNear(const QImage& image, const QColor& color, int tolerance) {
     return count;
 }
 
-void writeClassifiedLas(const QString& path) {
+void writeClassifiedLas(const QString& path, bool oneClass) {
     constexpr int kSide = 40;
     Bounds bounds;
     bounds.extend(glm::dvec3(300000.0, 5000000.0, 50.0));
@@ -100,9 +100,10 @@ void writeClassifiedLas(const QString& path) {
         for (int i = 0; i < kSide; ++i) {
             batch.positions.push_back(cube.toUnit(glm::dvec3(300000.0 + i, 5000000.0 + j, 50.0)));
             LasFields fields;
-            fields.classification = i < kSide / 2 ? 2 : 6;
-            fields.returns = static_cast<std::uint8_t>((j % 4 + 1) | (4 << 4));
-            fields.gpsTime = 4e8 + 10.0 * i;
+            fields.classification = i < kSide / 2 && !oneClass ? 2 : 6;
+            fields.returns =
+                static_cast<std::uint8_t>(oneClass ? 1 | (1 << 4) : (j % 4 + 1) | (4 << 4));
+            fields.gpsTime = oneClass ? 4e8 : 4e8 + 10.0 * i;
             batch.las.resize(batch.las.size() + stride);
             encodeLasFields(batch.attributes, fields, batch.las.data() + batch.las.size() - stride);
         }

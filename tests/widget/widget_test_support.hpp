@@ -47,8 +47,10 @@ int pixelsNear(const QImage& image, const QColor& color, int tolerance = 12);
 // A classified LAS 1.4 (point format 6) test cloud at `path`: a flat 40 x 40 grid of points
 // 1 m apart (x = 300000 + i, y = 5000000 + j, z = 50), class 2 (Ground) where i < 20 and
 // class 6 (Building) where i >= 20; return number j % 4 + 1 of 4; GPS time 4e8 + 10 i (a
-// ramp along x at a magnitude a float would not resolve to the second). Throws on failure.
-void writeClassifiedLas(const QString& path);
+// ramp along x at a magnitude a float would not resolve to the second). `oneClass`: every
+// point class 6, return 1 of 1, GPS time 4e8, so that every LAS record is the same (a uniform
+// column, stored once by the sorter). Throws on failure.
+void writeClassifiedLas(const QString& path, bool oneClass = false);
 inline constexpr int kClassifiedLasPointsPerClass = 800;
 
 } // namespace omicron::test
