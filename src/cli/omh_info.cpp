@@ -14,6 +14,18 @@ namespace omicron::cli {
 
 namespace {
 
+// The columns stored once in the header (version 2) instead of in every record.
+std::vector<std::string> uniformColumnNames(const omh::Header& h) {
+    std::vector<std::string> names;
+    if ((h.uniformColumns & omh::kUniformIntensityBit) != 0) {
+        names.push_back("intensity " + std::to_string(h.uniformIntensity));
+    }
+    if ((h.uniformColumns & omh::kUniformLasBit) != 0) {
+        names.emplace_back("LAS record");
+    }
+    return names;
+}
+
 void writeVector(JsonWriter& json, const glm::dvec3& v) {
     json.beginArray().value(v.x).value(v.y).value(v.z).endArray();
 }
@@ -38,6 +50,11 @@ void printJson(const omh::Header& h, bool verified) {
     json.endArray();
     json.key("estimated_normals").value(h.estimatedNormals);
     json.key("record_bytes").value(static_cast<std::uint64_t>(h.recordBytes));
+    json.key("uniform_columns").beginArray();
+    for (const std::string& name : uniformColumnNames(h)) {
+        json.value(name);
+    }
+    json.endArray();
     json.key("offset");
     writeVector(json, h.sourceOffset);
     json.key("cube").beginObject();
@@ -71,6 +88,13 @@ void printText(const omh::Header& h, bool verified) {
                 static_cast<unsigned long long>(h.totalPoints));
     std::printf("attributes:  %s%s\n", attributes.empty() ? "none" : attributes.c_str(),
                 h.estimatedNormals ? " (+ estimated normals)" : "");
+    std::string uniform;
+    for (const std::string& name : uniformColumnNames(h)) {
+        uniform.append(uniform.empty() ? "" : ", ").append(name);
+    }
+    if (!uniform.empty()) {
+        std::printf("uniform:     %s (one value for every point, stored once)\n", uniform.c_str());
+    }
     std::printf("cube:        origin %.6f %.6f %.6f, edge %.6f; offset %.6f %.6f %.6f\n",
                 h.cube.origin.x, h.cube.origin.y, h.cube.origin.z, h.cube.edge,
                 h.sourceOffset.x, h.sourceOffset.y, h.sourceOffset.z);

@@ -51,6 +51,9 @@ std::array<std::uint8_t, kHeaderBytes> encodeHeader(const Header& h) {
         storeRaw(at + f::kSourceOffset + 8 * axis, h.sourceOffset[axis]);
     }
     storeRaw(at + f::kCubeEdge, h.cube.edge);
+    storeRaw(at + f::kUniformColumns, h.uniformColumns);
+    storeRaw(at + f::kUniformIntensity, h.uniformIntensity);
+    std::memcpy(at + f::kUniformLasRecord, h.uniformLasRecord.data(), h.uniformLasRecord.size());
     storeRaw(at + f::kChecksum, smallChecksum(at, f::kChecksum));
     return bytes;
 }

@@ -34,7 +34,9 @@ namespace omicron::omh {
 
 inline constexpr std::array<char, 8> kMagic{'O', 'M', 'I', 'C', 'R', 'O', 'N', 'H'};
 inline constexpr std::array<char, 8> kFooterMagic{'O', 'M', 'H', 'E', 'N', 'D', '\0', '\0'};
-inline constexpr std::uint32_t kVersion = 1;
+// Version 2 added uniform columns (header bytes 130-247, zero in version 1, which still loads).
+inline constexpr std::uint32_t kVersion = 2;
+inline constexpr std::uint32_t kOldestVersion = 1;
 inline constexpr std::uint32_t kEndiannessMarker = oms::kEndiannessMarker;
 inline constexpr std::uint8_t kKnownAttributeBits = oms::kKnownAttributeBits;
 // Splat bit 0: each record carries the estimated normal (the cloud has no normals of its own).
@@ -67,9 +69,20 @@ inline constexpr std::size_t kCubeOrigin = 72;      // f64[3]
 inline constexpr std::size_t kCubeEdge = 96;        // f64, > 0
 inline constexpr std::size_t kSourceOffset = 104;   // f64[3]
 inline constexpr std::size_t kExtraBytes = 128;     // u16, LAS extra bytes a point (Las only)
-inline constexpr std::size_t kReserved1 = 130;      // 118 zero bytes
-inline constexpr std::size_t kChecksum = 248;       // u64, XXH64 of bytes [0, 248)
+// Version 2: a column every point holds the same value of is stored here once, not in the
+// records (a uniform column: see SortedCloud::setUniformColumns). Version 1: all zero.
+inline constexpr std::size_t kUniformColumns = 130;   // u8, kUniform* bits
+inline constexpr std::size_t kReserved2 = 131;        // u8, zero
+inline constexpr std::size_t kUniformIntensity = 132; // u16, with kUniformIntensityBit, else 0
+inline constexpr std::size_t kUniformLasRecord = 134; // the LAS column's record, with
+                                                      // kUniformLasBit; zero to kChecksum
+inline constexpr std::size_t kChecksum = 248;         // u64, XXH64 of bytes [0, 248)
 } // namespace header
+
+inline constexpr std::uint8_t kUniformIntensityBit = 0x01;
+inline constexpr std::uint8_t kUniformLasBit = 0x02;
+// A longer LAS record (many extra bytes) stays in the records even when it is uniform.
+inline constexpr std::size_t kMaxUniformLasBytes = header::kChecksum - header::kUniformLasRecord;
 
 namespace level {
 inline constexpr std::size_t kNodes = 0;             // u64
@@ -98,17 +111,37 @@ inline constexpr std::size_t kTotalPoints = 16; // u64
 inline constexpr std::size_t kChecksum = 24;   // u64, XXH64 of footer bytes [0, 24)
 } // namespace footer
 
-// A point record: the .oms record (position, optional normal, colour, intensity, LAS column), then the
-// splat radius (encodeRadius) and, when the splat bit says so, the octahedral estimated normal.
+// The attributes a record carries: the cloud's but its uniform columns (kUniform* bits).
+constexpr AttributeSet recordAttributes(AttributeSet attributes, std::uint8_t uniformColumns) {
+    std::uint8_t bits = attributes.bits();
+    std::uint16_t extraBytes = attributes.extraBytes();
+    if ((uniformColumns & kUniformIntensityBit) != 0) {
+        bits &= static_cast<std::uint8_t>(~static_cast<unsigned>(Attribute::Intensity));
+    }
+    if ((uniformColumns & kUniformLasBit) != 0) {
+        bits &= static_cast<std::uint8_t>(~static_cast<unsigned>(Attribute::Las) &
+                                          ~static_cast<unsigned>(Attribute::GpsTime) &
+                                          ~static_cast<unsigned>(Attribute::Nir));
+        extraBytes = 0;
+    }
+    return AttributeSet::fromBits(bits, extraBytes);
+}
+
+// A point record: the .oms record (position, optional normal, colour, intensity, LAS column;
+// not the uniform columns), then the splat radius (encodeRadius) and, when the splat bit says
+// so, the octahedral estimated normal.
 struct RecordLayout {
     oms::RecordLayout point;
+    AttributeSet attributes; // what the record carries of the cloud's attributes
     std::size_t radiusOffset = 0;
     std::size_t estimatedNormalOffset = 0;
     std::size_t bytes = 0;
 
-    static constexpr RecordLayout of(AttributeSet attributes, bool estimatedNormal) {
+    static constexpr RecordLayout of(AttributeSet attributes, bool estimatedNormal,
+                                     std::uint8_t uniformColumns = 0) {
         RecordLayout layout;
-        layout.point = oms::RecordLayout::of(attributes);
+        layout.attributes = recordAttributes(attributes, uniformColumns);
+        layout.point = oms::RecordLayout::of(layout.attributes);
         layout.radiusOffset = layout.point.bytes;
         std::size_t at = layout.radiusOffset + sizeof(std::uint16_t);
         if (estimatedNormal) {
@@ -148,6 +181,10 @@ struct Header {
     BuildInfo build;
     AttributeSet attributes;
     bool estimatedNormals = false;
+    // Version 2: the uniform columns (kUniform* bits) and their values.
+    std::uint8_t uniformColumns = 0;
+    std::uint16_t uniformIntensity = 0;
+    std::vector<std::uint8_t> uniformLasRecord; // attributes.lasBytes() bytes, or none
     std::size_t recordBytes = 0;
     CubeTransform cube;
     glm::dvec3 sourceOffset{0.0};

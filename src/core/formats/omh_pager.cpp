@@ -16,9 +16,10 @@ constexpr double kEvictTo = 0.875;
 } // namespace
 
 std::uint64_t OmhPager::residentBytesPerPoint(const omh::Header& header) {
-    // The cloud's point, then the stored splat radius and estimated normal.
-    return pointBytes(header.attributes) + sizeof(std::uint16_t) +
-           (header.estimatedNormals ? sizeof(std::uint32_t) : 0);
+    // The cloud's point (but its uniform columns, stored once), then the stored splat radius
+    // and estimated normal.
+    return pointBytes(omh::recordAttributes(header.attributes, header.uniformColumns)) +
+           sizeof(std::uint16_t) + (header.estimatedNormals ? sizeof(std::uint32_t) : 0);
 }
 
 OmhPager::OmhPager(const omh::Header& header, std::shared_ptr<SortedCloud> cloud,
@@ -40,10 +41,11 @@ OmhPager::OmhPager(const omh::Header& header, std::shared_ptr<SortedCloud> cloud
     m_pages.addArray(c.mutablePositions().data(), sizeof(glm::vec3), c.mutablePositions().size());
     m_pages.addArray(c.mutableNormals().data(), sizeof(glm::vec3), c.mutableNormals().size());
     m_pages.addArray(c.mutableColors().data(), sizeof(glm::u8vec3), c.mutableColors().size());
+    // A uniform column's one value is never paged out.
     m_pages.addArray(c.mutableIntensities().data(), sizeof(std::uint16_t),
-                     c.mutableIntensities().size());
+                     c.uniformIntensities() ? 0 : c.mutableIntensities().size());
     m_pages.addArray(c.mutableLasColumn().data(), c.attributes().lasBytes(),
-                     c.mutableLasColumn().empty() ? 0 : n);
+                     c.mutableLasColumn().empty() || c.uniformLasColumn() ? 0 : n);
     StoredSplats& splats = hierarchy.mutableStoredSplats();
     m_pages.addArray(splats.mutableRadii().data(), sizeof(std::uint16_t), n);
     m_pages.addArray(splats.mutableNormals().data(), sizeof(std::uint32_t),

@@ -128,10 +128,11 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
                     "in the header: expected the endianness marker bytes 04 03 02 01");
     }
     const auto version = loadRaw<std::uint32_t>(header.data() + h::kVersion);
-    if (version != omh::kVersion) {
+    if (version < omh::kOldestVersion || version > omh::kVersion) {
         throw error(InputErrorKind::UnsupportedFeature, h::kVersion,
-                    "in the header: expected .omh format version " + std::to_string(omh::kVersion) +
-                        ", found " + std::to_string(version));
+                    "in the header: expected .omh format version " +
+                        std::to_string(omh::kOldestVersion) + " to " +
+                        std::to_string(omh::kVersion) + ", found " + std::to_string(version));
     }
     const auto storedChecksum = loadRaw<std::uint64_t>(header.data() + h::kChecksum);
     const std::uint64_t headerChecksum = omh::smallChecksum(header.data(), h::kChecksum);
@@ -197,7 +198,42 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
                             " for these attributes, found " + std::to_string(splatBits));
     }
     info.estimatedNormals = expectedEstimate;
-    m_layout = omh::RecordLayout::of(info.attributes, info.estimatedNormals);
+    // Uniform columns (version 2; the bytes are zero in version 1, checked below).
+    std::size_t reservedFrom = h::kUniformColumns;
+    if (version >= 2) {
+        const std::uint8_t uniform = header[h::kUniformColumns];
+        if ((uniform & ~(omh::kUniformIntensityBit | omh::kUniformLasBit)) != 0) {
+            throw malformed(h::kUniformColumns, "unknown uniform column bits");
+        }
+        if ((uniform & omh::kUniformIntensityBit) != 0 &&
+            !info.attributes.has(Attribute::Intensity)) {
+            throw malformed(h::kUniformColumns,
+                            "a uniform intensity is declared, but the cloud has no intensities");
+        }
+        const std::size_t lasBytes = info.attributes.lasBytes();
+        if ((uniform & omh::kUniformLasBit) != 0 &&
+            (lasBytes == 0 || lasBytes > omh::kMaxUniformLasBytes)) {
+            throw malformed(h::kUniformColumns,
+                            "a uniform LAS column is declared, but the cloud's LAS records are " +
+                                std::to_string(lasBytes) + " bytes (expected 1-" +
+                                std::to_string(omh::kMaxUniformLasBytes) + ")");
+        }
+        info.uniformColumns = uniform;
+        info.uniformIntensity = loadRaw<std::uint16_t>(header.data() + h::kUniformIntensity);
+        if ((uniform & omh::kUniformIntensityBit) == 0 && info.uniformIntensity != 0) {
+            throw malformed(h::kUniformIntensity, "expected zero: the intensity is not uniform");
+        }
+        reservedFrom = h::kUniformLasRecord;
+        if ((uniform & omh::kUniformLasBit) != 0) {
+            info.uniformLasRecord.assign(header.data() + h::kUniformLasRecord,
+                                         header.data() + h::kUniformLasRecord + lasBytes);
+            reservedFrom += lasBytes;
+        }
+        if (header[h::kReserved2] != 0) {
+            throw malformed(h::kReserved2, "expected a reserved zero byte");
+        }
+    }
+    m_layout = omh::RecordLayout::of(info.attributes, info.estimatedNormals, info.uniformColumns);
     info.recordBytes = loadRaw<std::uint16_t>(header.data() + h::kRecordBytes);
     if (info.recordBytes != m_layout.bytes) {
         throw malformed(h::kRecordBytes, "expected a record size of " +
@@ -209,9 +245,9 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
             throw malformed(at, "expected a reserved zero byte");
         }
     }
-    for (std::size_t at = h::kReserved1; at < h::kChecksum; ++at) {
+    for (std::size_t at = reservedFrom; at < h::kChecksum; ++at) {
         if (header[at] != 0) {
-            throw malformed(at, "expected reserved bytes " + std::to_string(h::kReserved1) + "-" +
+            throw malformed(at, "expected reserved bytes " + std::to_string(reservedFrom) + "-" +
                                     std::to_string(h::kChecksum - 1) + " to be zero");
         }
     }
@@ -356,6 +392,14 @@ void OmhReader::createHierarchy() {
             m_header.cube, m_header.sourceOffset, m_header.attributes,
             static_cast<std::size_t>(m_header.totalPoints), CloudOrder::NodeOrder,
             PointStorage::Exact, pagedOnDemand() ? PageSize::Small : PageSize::Huge);
+        if (m_header.uniformColumns != 0) {
+            m_cloud->setUniformColumns((m_header.uniformColumns & omh::kUniformIntensityBit) != 0
+                                           ? &m_header.uniformIntensity
+                                           : nullptr,
+                                       (m_header.uniformColumns & omh::kUniformLasBit) != 0
+                                           ? m_header.uniformLasRecord.data()
+                                           : nullptr);
+        }
         m_hierarchy =
             std::make_shared<Hierarchy>(m_cloud, m_header.build.maxLevel, SplatSource::Stored);
         if (pagedOnDemand()) {

@@ -11,9 +11,11 @@ namespace omicron {
 
 OmhRecordDecoder::OmhRecordDecoder(const omh::Header& header, SortedCloud& cloud,
                                    StoredSplats& splats)
-    : m_header(header), m_layout(omh::RecordLayout::of(header.attributes, header.estimatedNormals)),
-      m_attributes(header.attributes), m_estimatedNormals(header.estimatedNormals), m_cloud(cloud),
-      m_splats(splats) {}
+    : m_header(header), m_layout(omh::RecordLayout::of(header.attributes, header.estimatedNormals,
+                                                       header.uniformColumns)),
+      // Without the uniform columns: the reader stored their values once.
+      m_attributes(m_layout.attributes), m_estimatedNormals(header.estimatedNormals),
+      m_cloud(cloud), m_splats(splats) {}
 
 std::size_t OmhRecordDecoder::store(const std::uint8_t* records, std::size_t count,
                                     std::size_t point, morton::Code nodeCode, int level) const {

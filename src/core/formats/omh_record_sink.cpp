@@ -38,7 +38,7 @@ template <std::size_t LasBytes = 0>
 void encodeRecord(const SortedCloud& cloud, const omh::RecordLayout& layout, std::uint32_t index,
                   std::uint16_t encodedRadius, std::uint32_t estimatedNormal,
                   std::uint8_t* record) {
-    const AttributeSet attributes = cloud.attributes();
+    const AttributeSet attributes = layout.attributes; // without the uniform columns
     storeRaw(record, cloud.position(index));
     if (attributes.has(Attribute::Normal)) {
         storeRaw(record + layout.point.normalOffset, cloud.normals()[index]);
@@ -67,7 +67,7 @@ template <std::size_t LasBytes, typename HeldAt>
 void encodeExactRecords(const SortedCloud& cloud, const omh::RecordLayout& layout, HeldAt heldAt,
                         const NodeSplats& splats, std::uint32_t first, std::uint32_t last,
                         std::uint8_t* out) {
-    const AttributeSet attributes = cloud.attributes();
+    const AttributeSet attributes = layout.attributes; // without the uniform columns
     const glm::vec3* const positions = cloud.positions().data();
     const glm::vec3* const normals =
         attributes.has(Attribute::Normal) ? cloud.normals().data() : nullptr;

@@ -202,8 +202,18 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
     header.build = build;
     header.attributes = cloud.attributes();
     header.estimatedNormals = hierarchy.estimatesNormals();
+    // Uniform columns go into the header once instead of into every record.
+    if (cloud.uniformIntensities()) {
+        header.uniformColumns |= omh::kUniformIntensityBit;
+        header.uniformIntensity = cloud.intensities()[0];
+    }
+    const std::size_t lasBytes = header.attributes.lasBytes();
+    if (cloud.uniformLasColumn() && lasBytes <= omh::kMaxUniformLasBytes) {
+        header.uniformColumns |= omh::kUniformLasBit;
+        header.uniformLasRecord.assign(cloud.lasRecord(0), cloud.lasRecord(0) + lasBytes);
+    }
     const omh::RecordLayout layout =
-        omh::RecordLayout::of(header.attributes, header.estimatedNormals);
+        omh::RecordLayout::of(header.attributes, header.estimatedNormals, header.uniformColumns);
     header.recordBytes = layout.bytes;
     header.cube = cloud.cube();
     header.sourceOffset = cloud.sourceOffset();

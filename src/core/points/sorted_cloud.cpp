@@ -77,7 +77,7 @@ SortedCloud::InPlaceArrays SortedCloud::inPlaceArrays() {
 }
 
 void SortedCloud::setUniformColumns(const std::uint16_t* intensity, const std::uint8_t* lasRecord) {
-    assert(m_sortedEnd.load(std::memory_order_relaxed) == 0 && !fileBacked() && !pagedOnDemand());
+    assert(m_sortedEnd.load(std::memory_order_relaxed) == 0 && !fileBacked());
     if (intensity != nullptr) {
         assert(m_intensities.size() != 0);
         m_intensities.data()[0] = *intensity;

@@ -321,6 +321,123 @@ std::string loadError(const std::string& path) {
     return "";
 }
 
+// ---- Uniform columns (version 2) ----
+
+// makeCloud's points with intensities and a LAS column (GPS time and `extraBytes` extra bytes):
+// one value for every point where `uniformIntensity` / `uniformLas`, else varying.
+SyntheticCloud withLasColumns(bool uniformIntensity, bool uniformLas,
+                              std::uint16_t extraBytes = 0) {
+    SyntheticCloud cloud = makeCloud(Shape::Random, 3000, 5);
+    cloud.info.attributes.add(Attribute::Intensity).add(Attribute::Las).add(Attribute::GpsTime);
+    cloud.info.attributes.setExtraBytes(extraBytes);
+    cloud.points.attributes = cloud.info.attributes;
+    const std::size_t lasBytes = cloud.info.attributes.lasBytes();
+    for (std::size_t i = 0; i < cloud.points.size(); ++i) {
+        cloud.points.intensities.push_back(uniformIntensity ? 300 : static_cast<std::uint16_t>(i));
+        for (std::size_t b = 0; b < lasBytes; ++b) {
+            cloud.points.las.push_back(static_cast<std::uint8_t>(uniformLas ? b + 1 : i * 7 + b));
+        }
+    }
+    return cloud;
+}
+
+TEST(OmhUniformColumns, AreStoredOnceInTheHeaderAndLoadBitExact) {
+    TempDir dir;
+    const std::size_t fullRecord =
+        omh::RecordLayout::of(withLasColumns(false, false).info.attributes, true).bytes;
+    for (const bool uniformIntensity : {false, true}) {
+        for (const bool uniformLas : {false, true}) {
+            SCOPED_TRACE(std::string(uniformIntensity ? "uniform" : "varying") + " intensity, " +
+                         (uniformLas ? "uniform" : "varying") + " LAS column");
+            const BuildResult built =
+                buildSynthetic(withLasColumns(uniformIntensity, uniformLas), options(4, {}));
+            ASSERT_EQ(built.cloud->uniformIntensities(), uniformIntensity);
+            ASSERT_EQ(built.cloud->uniformLasColumn(), uniformLas);
+            ASSERT_NO_FATAL_FAILURE(expectRoundTrip(built, dir));
+            OmhReader reader(dir.file("first.omh"));
+            const omh::Header& header = reader.header();
+            EXPECT_EQ(header.version, omh::kVersion);
+            EXPECT_EQ(header.uniformColumns, (uniformIntensity ? omh::kUniformIntensityBit : 0) |
+                                                 (uniformLas ? omh::kUniformLasBit : 0));
+            EXPECT_EQ(header.recordBytes,
+                      fullRecord - (uniformIntensity ? 2 : 0) - (uniformLas ? 16 : 0));
+            // Loaded (in memory, and paged on demand), the columns are uniform again.
+            const auto loaded = loadAll(dir.file("first.omh"));
+            EXPECT_EQ(loaded->cloud().uniformIntensities(), uniformIntensity);
+            EXPECT_EQ(loaded->cloud().uniformLasColumn(), uniformLas);
+            OmhReader paged(dir.file("first.omh"));
+            paged.pageOnDemand(std::uint64_t{1} << 30);
+            const auto pagedHierarchy = paged.hierarchy();
+            paged.load();
+            EXPECT_EQ(pagedHierarchy->cloud().uniformLasColumn(), uniformLas);
+        }
+    }
+}
+
+TEST(OmhUniformColumns, ALasRecordTooLongForTheHeaderStaysInTheRecords) {
+    TempDir dir;
+    // 8 + 8 GPS time + 100 extra bytes: more than the header's room.
+    const BuildResult built = buildSynthetic(withLasColumns(true, true, 100), options(3, {}));
+    ASSERT_GT(built.cloud->attributes().lasBytes(), omh::kMaxUniformLasBytes);
+    ASSERT_TRUE(built.cloud->uniformLasColumn());
+    ASSERT_NO_FATAL_FAILURE(expectRoundTrip(built, dir));
+    EXPECT_EQ(OmhReader(dir.file("first.omh")).header().uniformColumns, omh::kUniformIntensityBit);
+}
+
+// `bytes` with header byte `at` set to `value` and the header checksum made right again.
+std::vector<std::uint8_t> withHeaderByte(std::vector<std::uint8_t> bytes, std::size_t at,
+                                         std::uint8_t value) {
+    bytes[at] = value;
+    const std::uint64_t checksum = omh::smallChecksum(bytes.data(), omh::header::kChecksum);
+    std::memcpy(bytes.data() + omh::header::kChecksum, &checksum, sizeof checksum);
+    return bytes;
+}
+
+TEST(OmhUniformColumns, AVersion1FileStillLoads) {
+    TempDir dir;
+    // Without uniform columns a version 2 file is a version 1 file but for its version.
+    const BuildResult built = buildSynthetic(withLasColumns(false, false), options(4, {}));
+    save(dir.file("v2.omh"), built);
+    const std::string v1 = dir.file("v1.omh");
+    writeBytes(v1, withHeaderByte(readBytes(dir.file("v2.omh")), omh::header::kVersion, 1));
+    OmhReader reader(v1);
+    EXPECT_EQ(reader.header().version, 1u);
+    const auto loaded = reader.hierarchy();
+    reader.load();
+    expectSameHierarchy(built.builder->hierarchy(), *loaded);
+    // Version 1 had no uniform columns: its bytes 130-247 are reserved zeros.
+    writeBytes(
+        v1, withHeaderByte(readBytes(v1), omh::header::kUniformColumns, omh::kUniformIntensityBit));
+    EXPECT_NE(loadError(v1).find("expected reserved bytes 130-247 to be zero"), std::string::npos)
+        << loadError(v1);
+}
+
+TEST(OmhUniformColumns, BadUniformFieldsAreClearErrors) {
+    TempDir dir;
+    save(dir.file("uniform.omh"), buildSynthetic(withLasColumns(true, true), options(3, {})));
+    save(dir.file("plain.omh"), buildSynthetic(makeCloud(Shape::Random, 500, 3), options(3, {})));
+    const std::vector<std::uint8_t> uniform = readBytes(dir.file("uniform.omh"));
+    const std::vector<std::uint8_t> plain = readBytes(dir.file("plain.omh"));
+    const std::string bad = dir.file("bad.omh");
+    const auto expectError = [&](const std::vector<std::uint8_t>& bytes, const std::string& words) {
+        writeBytes(bad, bytes);
+        const std::string message = loadError(bad);
+        EXPECT_NE(message.find(bad), std::string::npos) << message;
+        EXPECT_NE(message.find(words), std::string::npos) << message;
+    };
+    expectError(withHeaderByte(uniform, omh::header::kUniformColumns, 0x07),
+                "unknown uniform column bits");
+    expectError(withHeaderByte(plain, omh::header::kUniformColumns, omh::kUniformIntensityBit),
+                "the cloud has no intensities");
+    expectError(withHeaderByte(plain, omh::header::kUniformColumns, omh::kUniformLasBit),
+                "a uniform LAS column is declared");
+    expectError(withHeaderByte(plain, omh::header::kReserved2, 1), "reserved zero byte");
+    expectError(withHeaderByte(plain, omh::header::kVersion, 3), "format version 1 to 2, found 3");
+    // The uniform LAS record ends at byte 134 + 16: a byte after it must be zero.
+    expectError(withHeaderByte(uniform, omh::header::kUniformLasRecord + 16, 9),
+                "expected reserved bytes 150-247 to be zero");
+}
+
 TEST(OmhDamage, EveryByteFlipIsDetectedAndNamesTheSection) {
     SmallFile file;
     ASSERT_GT(file.header.levels[2].points, 0u);
