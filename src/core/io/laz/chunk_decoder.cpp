@@ -248,14 +248,15 @@ void ChunkDecoder::decodePointwise(std::uint8_t* records, std::uint64_t count) {
     }
 }
 
+// An item at a time over the points (POINT14 a layer at a time), not a point at a time over the
+// items: the layers are independent streams (the other items only need each point's scanner
+// channel from POINT14), and one stream's loop keeps its state and branch history to itself.
 void ChunkDecoder::decodeLayered(std::uint8_t* records, std::uint64_t count) {
-    for (std::uint64_t p = 0; p < count; ++p) {
-        std::uint8_t* record = records + p * m_recordLength;
-        m_point14->decode(record, 0);
-        const std::uint32_t channel = m_point14->channel();
-        for (std::size_t i = 0; i < m_layered.size(); ++i) {
-            m_layered[i]->decode(record + m_itemOffsets[i + 1], channel);
-        }
+    m_channels.resize(count);
+    m_point14->decode(records, count, m_recordLength, m_channels.data());
+    for (std::size_t i = 0; i < m_layered.size(); ++i) {
+        m_layered[i]->decode(records + m_itemOffsets[i + 1], count, m_recordLength,
+                             m_channels.data());
     }
 }
 

@@ -84,6 +84,7 @@ private:
     std::vector<std::uint64_t> m_layerStarts;
     std::vector<std::uint64_t> m_layerSizes;
     std::vector<std::string> m_layerNames;
+    std::vector<std::uint8_t> m_channels; // each point's scanner channel, for the other items
 };
 
 } // namespace omicron::laz

@@ -6,6 +6,7 @@
 
 #include "io/laz/arithmetic_decoder.hpp"
 
+#include <cassert>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -48,5 +49,51 @@ private:
     // fresh model is what the encoder started from too).
     std::vector<std::unique_ptr<SymbolModel>> m_correctorModels;
 };
+
+// Inline: the layer loops that call these keep their decoder's state in registers.
+inline SymbolModel& IntegerDecoder::correctorModel(std::uint32_t k) {
+    std::unique_ptr<SymbolModel>& model = m_correctorModels[k];
+    if (!model) {
+        const std::uint32_t codedBits = k <= m_bitsHigh ? k : m_bitsHigh;
+        model = std::make_unique<SymbolModel>(std::uint32_t{1} << codedBits);
+    }
+    return *model;
+}
+
+inline std::int32_t IntegerDecoder::readCorrector(ArithmeticDecoder& decoder,
+                                                  SymbolModel& classModel) {
+    m_k = decoder.decodeSymbol(classModel);
+    if (m_k == 0) {
+        return static_cast<std::int32_t>(decoder.decodeBit(m_corrector0));
+    }
+    if (m_k >= 32) {
+        return m_correctorMin;
+    }
+    std::uint32_t corrector = decoder.decodeSymbol(correctorModel(m_k));
+    if (m_k > m_bitsHigh) {
+        const std::uint32_t rawBits = m_k - m_bitsHigh;
+        corrector = (corrector << rawBits) | decoder.readBits(rawBits);
+    }
+    // Class k holds [-(2^k - 1), -2^(k-1)] and [2^(k-1) + 1, 2^k], coded as [0, 2^k).
+    if (corrector >= (std::uint32_t{1} << (m_k - 1))) {
+        return static_cast<std::int32_t>(corrector + 1);
+    }
+    return static_cast<std::int32_t>(corrector - ((std::uint32_t{1} << m_k) - 1));
+}
+
+inline std::int32_t IntegerDecoder::decode(ArithmeticDecoder& decoder, std::int32_t prediction,
+                                           std::uint32_t context) {
+    assert(context < m_classModels.size());
+    const std::int32_t corrector = readCorrector(decoder, m_classModels[context]);
+    // Unsigned arithmetic: the sum wraps like the encoder's 32-bit registers.
+    std::uint32_t value =
+        static_cast<std::uint32_t>(prediction) + static_cast<std::uint32_t>(corrector);
+    if (static_cast<std::int32_t>(value) < 0) {
+        value += m_correctorRange;
+    } else if (m_correctorRange != 0 && value >= m_correctorRange) {
+        value -= m_correctorRange;
+    }
+    return static_cast<std::int32_t>(value);
+}
 
 } // namespace omicron::laz

@@ -40,6 +40,15 @@ public:
     // Decodes the next point's item into `item`; `channel` is the point's scanner channel, as
     // POINT14 decoded it.
     virtual void decode(std::uint8_t* item, std::uint32_t channel) = 0;
+
+    // The next `count` points' items at `items`, `stride` bytes apart, in scanner channels
+    // `channels`: a loop over decode(), unless an item keeps its layers' state in registers.
+    virtual void decode(std::uint8_t* items, std::size_t count, std::size_t stride,
+                        const std::uint8_t* channels) {
+        for (std::size_t i = 0; i < count; ++i) {
+            decode(items + i * stride, channels[i]);
+        }
+    }
 };
 
 // The per-channel state of RGB14, RGBNIR14 and BYTE14: `Models` (built from the item's byte

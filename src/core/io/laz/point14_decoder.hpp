@@ -25,6 +25,10 @@ public:
                std::span<Layer> layers) override;
     // `channel` is ignored: POINT14 decodes it (see channel()).
     void decode(std::uint8_t* item, std::uint32_t channel) override;
+    // Decodes the next `count` points into the items at `items`, `stride` bytes apart, a layer
+    // at a time over all of them (each layer is its own stream: one stream's loop keeps its
+    // state and branch history to itself); `channels` receives each point's scanner channel.
+    void decode(std::uint8_t* items, std::size_t count, std::size_t stride, std::uint8_t* channels);
 
     // The scanner channel of the last point decoded (or started from).
     std::uint32_t channel() const { return m_current; }
@@ -49,13 +53,32 @@ private:
         std::uint64_t gpsTimeBits = 0;
 
         static Fields load(const std::uint8_t* item);
-        void store(std::uint8_t* item) const;
     };
     struct Context;
+    // What the first layer tells the others about one point.
+    struct PointContext {
+        std::uint8_t channel;  // its scanner channel: whose context and predictions
+        std::uint8_t opened;   // 1: its channel's context opened here, from the point before
+        std::uint8_t changed;  // the change mask
+        std::uint8_t position; // single (3), first (2), last (1) or intermediate (0) return
+        std::uint8_t level;    // the return level of Z's predictions
+        std::uint8_t zModel;   // Z's magnitude-class model
+        std::uint8_t single;   // one return
+        std::uint8_t gpsBit;   // the GPS time changed
+    };
 
     Context& open(std::uint32_t channel, const Fields& from);
+    void decodeChannelReturnsXY(std::uint8_t* items, std::size_t count, std::size_t stride);
+    // Other layers over the points, in one loop: each `field(context, before, point, item)`
+    // decodes (or, for a layer of 0 bytes, keeps) one point's field in its channel's context,
+    // `before` being the context of the point before when the channel opened at this point,
+    // else null.
+    template <typename... Field>
+    void decodeLayers(std::uint8_t* items, std::size_t count, std::size_t stride,
+                      std::uint32_t startChannel, Field... fields);
 
     std::span<Layer> m_layers;
+    std::vector<PointContext> m_points; // the slice being decoded
     std::array<std::unique_ptr<Context>, 4> m_contexts;
     std::uint32_t m_current = 0;
 };

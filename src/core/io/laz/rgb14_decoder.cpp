@@ -17,9 +17,29 @@ void Rgb14Decoder::start(const std::uint8_t* firstItem, std::uint32_t channel,
 }
 
 void Rgb14Decoder::decode(std::uint8_t* item, std::uint32_t channel) {
+    ArithmeticDecoder unused;
+    decodeOne(item, channel, m_rgbLayer->decoder, m_nirLayer ? m_nirLayer->decoder : unused);
+}
+
+void Rgb14Decoder::decode(std::uint8_t* items, std::size_t count, std::size_t stride,
+                          const std::uint8_t* channels) {
+    // Copies in locals, put back after the loop: their state stays in registers.
+    ArithmeticDecoder rgb = m_rgbLayer->decoder;
+    ArithmeticDecoder nir = m_nirLayer ? m_nirLayer->decoder : ArithmeticDecoder();
+    for (std::size_t i = 0; i < count; ++i) {
+        decodeOne(items + i * stride, channels[i], rgb, nir);
+    }
+    m_rgbLayer->decoder = rgb;
+    if (m_nirLayer) {
+        m_nirLayer->decoder = nir;
+    }
+}
+
+inline void Rgb14Decoder::decodeOne(std::uint8_t* item, std::uint32_t channel,
+                                    ArithmeticDecoder& rgbDecoder, ArithmeticDecoder& nirDecoder) {
     const auto selected = m_contexts.select(channel);
     if (m_rgbLayer->present) {
-        const Rgb rgb = decodeRgb(m_rgbLayer->decoder, selected.models.rgb, loadRgb(selected.last));
+        const Rgb rgb = decodeRgb(rgbDecoder, selected.models.rgb, loadRgb(selected.last));
         storeRgb(selected.last, rgb);
     }
     std::memcpy(item, selected.last, 6);
@@ -27,7 +47,7 @@ void Rgb14Decoder::decode(std::uint8_t* item, std::uint32_t channel) {
         return;
     }
     if (m_nirLayer->present) {
-        ArithmeticDecoder& decoder = m_nirLayer->decoder;
+        ArithmeticDecoder& decoder = nirDecoder;
         Models& models = selected.models;
         std::uint16_t last;
         std::memcpy(&last, selected.last + 6, sizeof last);

@@ -17,6 +17,8 @@ public:
     void start(const std::uint8_t* firstItem, std::uint32_t channel,
                std::span<Layer> layers) override;
     void decode(std::uint8_t* item, std::uint32_t channel) override;
+    void decode(std::uint8_t* items, std::size_t count, std::size_t stride,
+                const std::uint8_t* channels) override;
 
 private:
     struct Models {
@@ -25,6 +27,9 @@ private:
         SymbolModel nirChangedBytes{4};
         std::array<SymbolModel, 2> nirByteDifference{SymbolModel(256), SymbolModel(256)};
     };
+
+    void decodeOne(std::uint8_t* item, std::uint32_t channel, ArithmeticDecoder& rgb,
+                   ArithmeticDecoder& nir);
 
     bool m_withNir;
     Layer* m_rgbLayer = nullptr;
