@@ -355,7 +355,6 @@ void Point14Decoder::decodeChannelReturnsXY(std::uint8_t* items, std::size_t cou
         out.position = static_cast<std::uint8_t>((r == 1 ? 2u : 0u) + (r >= n ? 1u : 0u));
         out.level = static_cast<std::uint8_t>(returnLevel8Of16(n, r));
         out.zModel = static_cast<std::uint8_t>(single + evenClass((c.dx.k() + c.dy.k()) / 2, 18));
-        out.single = static_cast<std::uint8_t>(single);
         out.gpsBit = static_cast<std::uint8_t>(gpsBit);
         storeRaw(items, p.x);
         storeRaw(items + 4, p.y);

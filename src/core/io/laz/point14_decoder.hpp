@@ -23,15 +23,12 @@ public:
     std::size_t layerCount() const override { return kPoint14Layers; }
     void start(const std::uint8_t* firstItem, std::uint32_t channel,
                std::span<Layer> layers) override;
-    // `channel` is ignored: POINT14 decodes it (see channel()).
+    // `channel` is ignored: POINT14 decodes it (the decode() below reports each point's).
     void decode(std::uint8_t* item, std::uint32_t channel) override;
     // Decodes the next `count` points into the items at `items`, `stride` bytes apart, a layer
     // at a time over all of them (each layer is its own stream: one stream's loop keeps its
     // state and branch history to itself); `channels` receives each point's scanner channel.
     void decode(std::uint8_t* items, std::size_t count, std::size_t stride, std::uint8_t* channels);
-
-    // The scanner channel of the last point decoded (or started from).
-    std::uint32_t channel() const { return m_current; }
 
     // The scanner channel stored in a raw POINT14 item.
     static std::uint32_t channelOf(const std::uint8_t* item) { return (item[15] >> 4) & 3u; }
@@ -63,7 +60,6 @@ private:
         std::uint8_t position; // single (3), first (2), last (1) or intermediate (0) return
         std::uint8_t level;    // the return level of Z's predictions
         std::uint8_t zModel;   // Z's magnitude-class model
-        std::uint8_t single;   // one return
         std::uint8_t gpsBit;   // the GPS time changed
     };
 
