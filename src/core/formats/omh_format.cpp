@@ -53,7 +53,10 @@ std::array<std::uint8_t, kHeaderBytes> encodeHeader(const Header& h) {
     storeRaw(at + f::kCubeEdge, h.cube.edge);
     storeRaw(at + f::kUniformColumns, h.uniformColumns);
     storeRaw(at + f::kUniformIntensity, h.uniformIntensity);
-    std::memcpy(at + f::kUniformLasRecord, h.uniformLasRecord.data(), h.uniformLasRecord.size());
+    if (!h.uniformLasRecord.empty()) { // memcpy from an empty vector's null data is undefined
+        std::memcpy(at + f::kUniformLasRecord, h.uniformLasRecord.data(),
+                    h.uniformLasRecord.size());
+    }
     storeRaw(at + f::kChecksum, smallChecksum(at, f::kChecksum));
     return bytes;
 }
