@@ -11,103 +11,17 @@ static_assert(std::endian::native == std::endian::little, "LAS fields are stored
 
 namespace omicron::laz {
 
-namespace {
-
-enum LayerIndex : std::size_t {
-    kChannelReturnsXY,
-    kZ,
-    kClassification,
-    kFlags,
-    kIntensity,
-    kScanAngle,
-    kUserData,
-    kPointSource,
-    kGpsTime,
-};
-
-// The first layer's change mask.
-constexpr unsigned kChannelChanged = 1u << 6;
-constexpr unsigned kPointSourceChanged = 1u << 5;
-constexpr unsigned kGpsTimeChanged = 1u << 4;
-constexpr unsigned kScanAngleChanged = 1u << 3;
-constexpr unsigned kNumberOfReturnsChanged = 1u << 2;
-constexpr unsigned kReturnNumberChange = 3u; // 0 same, 1 plus one, 2 minus one, 3 coded
-
-std::uint32_t evenClass(std::uint32_t k, std::uint32_t limit) {
-    return k < limit ? (k & ~1u) : limit;
-}
-
-} // namespace
-
-// One scanner channel's models and predictions.
-struct Point14Decoder::Context {
-    explicit Context(const Fields& from)
-        : last(from), gpsTime(GpsTimeDecoder::Alphabet::ChangedOnly, from.gpsTimeBits) {
-        lastZ.fill(from.z);
-        lastIntensity.fill(from.intensity);
-    }
-
-    Fields last;
-    bool lastGpsTimeChanged = false;
-
-    std::array<SymbolModel, 8> changedValues{SymbolModel(128), SymbolModel(128), SymbolModel(128),
-                                             SymbolModel(128), SymbolModel(128), SymbolModel(128),
-                                             SymbolModel(128), SymbolModel(128)};
-    SymbolModel scannerChannel{3};
-    std::array<std::unique_ptr<SymbolModel>, 16> numberOfReturns;
-    std::array<std::unique_ptr<SymbolModel>, 16> returnNumber;
-    SymbolModel returnNumberGpsSame{13};
-    IntegerDecoder dx{32, 2};
-    IntegerDecoder dy{32, 22};
-    IntegerDecoder z{32, 20};
-    std::array<std::unique_ptr<SymbolModel>, 64> classification;
-    std::array<std::unique_ptr<SymbolModel>, 64> flags;
-    std::array<std::unique_ptr<SymbolModel>, 64> userData;
-    IntegerDecoder intensity{16, 4};
-    IntegerDecoder scanAngle{16, 2};
-    IntegerDecoder pointSourceId{16};
-    GpsTimeDecoder gpsTime;
-
-    std::array<StreamingMedian5, 12> xDiffMedian;
-    std::array<StreamingMedian5, 12> yDiffMedian;
-    std::array<std::int32_t, 8> lastZ{};
-    std::array<std::uint16_t, 8> lastIntensity{};
-};
+using namespace point14;
 
 Point14Decoder::Point14Decoder() = default;
 Point14Decoder::~Point14Decoder() = default;
-
-Point14Decoder::Fields Point14Decoder::Fields::load(const std::uint8_t* item) {
-    Fields f;
-    f.x = loadRaw<std::int32_t>(item);
-    f.y = loadRaw<std::int32_t>(item + 4);
-    f.z = loadRaw<std::int32_t>(item + 8);
-    f.intensity = loadRaw<std::uint16_t>(item + 12);
-    f.returnNumber = item[14] & 15u;
-    f.numberOfReturns = item[14] >> 4;
-    f.classFlags = item[15] & 15u;
-    f.scannerChannel = (item[15] >> 4) & 3u;
-    f.scanDirection = (item[15] >> 6) & 1u;
-    f.edgeOfFlightLine = item[15] >> 7;
-    f.classification = item[16];
-    f.userData = item[17];
-    f.scanAngle = loadRaw<std::int16_t>(item + 18);
-    f.pointSourceId = loadRaw<std::uint16_t>(item + 20);
-    f.gpsTimeBits = loadRaw<std::uint64_t>(item + 22);
-    return f;
-}
-
-Point14Decoder::Context& Point14Decoder::open(std::uint32_t channel, const Fields& from) {
-    m_contexts[channel] = std::make_unique<Context>(from);
-    return *m_contexts[channel];
-}
 
 void Point14Decoder::start(const std::uint8_t* firstItem, std::uint32_t channel,
                            std::span<Layer> layers) {
     assert(layers.size() == kPoint14Layers);
     m_layers = layers;
-    m_current = channel & 3u;
-    open(m_current, Fields::load(firstItem));
+    m_contexts.current = channel & 3u;
+    m_contexts.open(m_contexts.current, Fields::load(firstItem));
 }
 
 void Point14Decoder::decode(std::uint8_t* item, std::uint32_t /*channel*/) {
@@ -117,7 +31,7 @@ void Point14Decoder::decode(std::uint8_t* item, std::uint32_t /*channel*/) {
 
 void Point14Decoder::decode(std::uint8_t* items, std::size_t count, std::size_t stride,
                             std::uint8_t* channels) {
-    const std::uint32_t startChannel = m_current;
+    const std::uint32_t startChannel = m_contexts.current;
     m_points.resize(count);
     decodeChannelReturnsXY(items, count, stride);
     for (std::size_t i = 0; i < count; ++i) {
@@ -271,8 +185,8 @@ void Point14Decoder::decodeLayers(std::uint8_t* items, std::size_t count, std::s
     std::uint32_t previous = startChannel;
     for (std::size_t i = 0; i < count; ++i, items += stride) {
         const PointContext& p = m_points[i];
-        Context& c = *m_contexts[p.channel];
-        const Context* before = p.opened != 0 ? m_contexts[previous].get() : nullptr;
+        Context& c = *m_contexts.slots[p.channel];
+        const Context* before = p.opened != 0 ? m_contexts.slots[previous].get() : nullptr;
         (fields(c, before, p, items), ...);
         previous = p.channel;
     }
@@ -283,81 +197,21 @@ void Point14Decoder::decodeChannelReturnsXY(std::uint8_t* items, std::size_t cou
     // A copy in a local, put back after the loop: its state stays in registers.
     ArithmeticDecoder xy = m_layers[kChannelReturnsXY].decoder;
     for (std::size_t i = 0; i < count; ++i, items += stride) {
+        const FirstLayerPoint first = decodeFirstLayer(xy, m_contexts);
+        const Context& c = *m_contexts.slots[m_contexts.current];
+        const std::uint32_t n = first.n;
+        const std::uint32_t r = first.r;
         PointContext& out = m_points[i];
-        out.opened = 0;
-        Context& previous = *m_contexts[m_current];
-        const Fields& before = previous.last;
-
-        // The change mask's model: was the last point a first return, a last return, and did
-        // its GPS time change?
-        const std::uint32_t lastReturnContext =
-            (before.returnNumber == 1 ? 1u : 0u) |
-            (before.returnNumber >= before.numberOfReturns ? 2u : 0u) |
-            (previous.lastGpsTimeChanged ? 4u : 0u);
-        const unsigned changed = xy.decodeSymbol(previous.changedValues[lastReturnContext]);
-
-        if (changed & kChannelChanged) {
-            const std::uint32_t step = xy.decodeSymbol(previous.scannerChannel);
-            const std::uint32_t channel = (m_current + step + 1) & 3u;
-            if (!m_contexts[channel]) {
-                // A channel's first point predicts from the point before: here its first
-                // layer's fields; each other layer copies its own when it gets to the point.
-                open(channel, before);
-                out.opened = 1;
-            }
-            m_current = channel;
-            m_contexts[channel]->last.scannerChannel = channel;
-        }
-        Context& c = *m_contexts[m_current];
-        Fields& p = c.last;
-        const bool gpsTimeChanged = (changed & kGpsTimeChanged) != 0;
-        const std::uint32_t gpsBit = gpsTimeChanged ? 1u : 0u;
-
-        std::uint32_t n = p.numberOfReturns;
-        if (changed & kNumberOfReturnsChanged) {
-            n = xy.decodeSymbol(lazyModel(c.numberOfReturns, n, 16));
-            p.numberOfReturns = n;
-        }
-        std::uint32_t r = p.returnNumber;
-        switch (changed & kReturnNumberChange) {
-        case 0:
-            break;
-        case 1:
-            r = (r + 1) & 15u;
-            break;
-        case 2:
-            r = (r + 15) & 15u;
-            break;
-        default:
-            if (gpsTimeChanged) {
-                r = xy.decodeSymbol(lazyModel(c.returnNumber, r, 16));
-            } else {
-                r = (r + xy.decodeSymbol(c.returnNumberGpsSame) + 2) & 15u;
-            }
-            break;
-        }
-        p.returnNumber = r;
-
-        const std::uint32_t map = returnMap6(n, r);
-        const std::uint32_t single = n == 1 ? 1u : 0u;
-        const std::size_t medianIndex = (map << 1) | gpsBit;
-        const std::int32_t dx = c.dx.decode(xy, c.xDiffMedian[medianIndex].median(), single);
-        p.x = wrappingAdd(p.x, dx);
-        c.xDiffMedian[medianIndex].add(dx);
-        const std::int32_t dy =
-            c.dy.decode(xy, c.yDiffMedian[medianIndex].median(), single + evenClass(c.dx.k(), 20));
-        p.y = wrappingAdd(p.y, dy);
-        c.yDiffMedian[medianIndex].add(dy);
-        c.lastGpsTimeChanged = gpsTimeChanged;
-
-        out.channel = static_cast<std::uint8_t>(m_current);
-        out.changed = static_cast<std::uint8_t>(changed);
+        out.channel = static_cast<std::uint8_t>(m_contexts.current);
+        out.opened = first.opened ? 1 : 0;
+        out.changed = static_cast<std::uint8_t>(first.changed);
         out.position = static_cast<std::uint8_t>((r == 1 ? 2u : 0u) + (r >= n ? 1u : 0u));
         out.level = static_cast<std::uint8_t>(returnLevel8Of16(n, r));
-        out.zModel = static_cast<std::uint8_t>(single + evenClass((c.dx.k() + c.dy.k()) / 2, 18));
-        out.gpsBit = static_cast<std::uint8_t>(gpsBit);
-        storeRaw(items, p.x);
-        storeRaw(items + 4, p.y);
+        out.zModel =
+            static_cast<std::uint8_t>(first.single + evenClass((c.dx.k() + c.dy.k()) / 2, 18));
+        out.gpsBit = (first.changed & kGpsTimeChanged) != 0 ? 1 : 0;
+        storeRaw(items, c.last.x);
+        storeRaw(items + 4, c.last.y);
         items[14] = static_cast<std::uint8_t>(r | (n << 4));
     }
     m_layers[kChannelReturnsXY].decoder = xy;

@@ -6,9 +6,8 @@
 // GPS time changed, with separate models and predictions per scanner channel.
 #pragma once
 
-#include "io/laz/gpstime_decoder.hpp"
 #include "io/laz/layered_item_decoder.hpp"
-#include "io/laz/streaming_median.hpp"
+#include "io/laz/point14_context.hpp"
 
 namespace omicron::laz {
 
@@ -34,24 +33,6 @@ public:
     static std::uint32_t channelOf(const std::uint8_t* item) { return (item[15] >> 4) & 3u; }
 
 private:
-    struct Fields {
-        std::int32_t x = 0, y = 0, z = 0;
-        std::uint16_t intensity = 0;
-        std::uint32_t returnNumber = 0;    // 4 bits
-        std::uint32_t numberOfReturns = 0; // 4 bits
-        std::uint32_t classFlags = 0;      // 4 bits
-        std::uint32_t scannerChannel = 0;  // 2 bits
-        std::uint32_t scanDirection = 0;
-        std::uint32_t edgeOfFlightLine = 0;
-        std::uint8_t classification = 0;
-        std::uint8_t userData = 0;
-        std::int16_t scanAngle = 0;
-        std::uint16_t pointSourceId = 0;
-        std::uint64_t gpsTimeBits = 0;
-
-        static Fields load(const std::uint8_t* item);
-    };
-    struct Context;
     // What the first layer tells the others about one point.
     struct PointContext {
         std::uint8_t channel;  // its scanner channel: whose context and predictions
@@ -63,7 +44,6 @@ private:
         std::uint8_t gpsBit;   // the GPS time changed
     };
 
-    Context& open(std::uint32_t channel, const Fields& from);
     void decodeChannelReturnsXY(std::uint8_t* items, std::size_t count, std::size_t stride);
     // Other layers over the points, in one loop: each `field(context, before, point, item)`
     // decodes (or, for a layer of 0 bytes, keeps) one point's field in its channel's context,
@@ -75,8 +55,7 @@ private:
 
     std::span<Layer> m_layers;
     std::vector<PointContext> m_points; // the slice being decoded
-    std::array<std::unique_ptr<Context>, 4> m_contexts;
-    std::uint32_t m_current = 0;
+    point14::Contexts m_contexts;
 };
 
 } // namespace omicron::laz
