@@ -4,6 +4,7 @@
 // the format and must be reproduced exactly, not replaced by a true median.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 
@@ -12,56 +13,26 @@ namespace omicron::laz {
 class StreamingMedian5 {
 public:
     std::int32_t median() const { return m_values[2]; }
+    // The five values, sorted (for tests).
+    const std::array<std::int32_t, 5>& values() const { return m_values; }
 
+    // Replacing at the high end drops the largest value and inserts `value` in order; at the
+    // low end, the smallest. Both are done without a branch (a coordinate difference falls
+    // anywhere among the five, so branches on it would be mispredicted): element i of a sorted
+    // s[0..3] with `value` inserted is max(s[i-1], min(s[i], value)).
     void add(std::int32_t value) {
         std::array<std::int32_t, 5>& v = m_values;
-        if (m_replaceHigh) {
-            if (value < v[2]) { // shift the top two up, insert below the middle
-                v[4] = v[3];
-                v[3] = v[2];
-                if (value < v[0]) {
-                    v[2] = v[1];
-                    v[1] = v[0];
-                    v[0] = value;
-                } else if (value < v[1]) {
-                    v[2] = v[1];
-                    v[1] = value;
-                } else {
-                    v[2] = value;
-                }
-            } else {
-                if (value < v[3]) {
-                    v[4] = v[3];
-                    v[3] = value;
-                } else {
-                    v[4] = value;
-                }
-                m_replaceHigh = false;
-            }
-        } else {
-            if (v[2] < value) { // shift the bottom two down, insert above the middle
-                v[0] = v[1];
-                v[1] = v[2];
-                if (v[4] < value) {
-                    v[2] = v[3];
-                    v[3] = v[4];
-                    v[4] = value;
-                } else if (v[3] < value) {
-                    v[2] = v[3];
-                    v[3] = value;
-                } else {
-                    v[2] = value;
-                }
-            } else {
-                if (v[1] < value) {
-                    v[0] = v[1];
-                    v[1] = value;
-                } else {
-                    v[0] = value;
-                }
-                m_replaceHigh = true;
-            }
-        }
+        const bool high = m_replaceHigh;
+        const std::int32_t s0 = high ? v[0] : v[1];
+        const std::int32_t s1 = high ? v[1] : v[2];
+        const std::int32_t s2 = high ? v[2] : v[3];
+        const std::int32_t s3 = high ? v[3] : v[4];
+        m_replaceHigh = value < v[2] || (!high && value == v[2]);
+        v[0] = std::min(s0, value);
+        v[1] = std::max(s0, std::min(s1, value));
+        v[2] = std::max(s1, std::min(s2, value));
+        v[3] = std::max(s2, std::min(s3, value));
+        v[4] = std::max(s3, value);
     }
 
 private:
