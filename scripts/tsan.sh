@@ -34,7 +34,7 @@ fi
 
 cmake --preset tsan -DTBB_DIR="$tbb_prefix/lib/cmake/TBB" >/dev/null
 cmake --build build/tsan --target omicron_core_tests
-filter=${1:-'*Builder*:*Sorter*:*Radix*:*Oms*:*ObliqueCut*:*Front*:*Packed*:*ChunkedArena*:*LeafRuns*:*ExternalSort*:*Budgeted*:*PrePass*:*OmhPaged*:*ResidentPages*:*OverlappedBatchConsumer*:*OmhWriter*:*OmhSafeSave*:*UniformColumns*'}
+filter=${1:-'*Builder*:*Sorter*:*Radix*:*Oms*:*ObliqueCut*:*Front*:*Packed*:*ChunkedArena*:*LeafRuns*:*ExternalSort*:*Budgeted*:*PrePass*:*OmhPaged*:*ResidentPages*:*OverlappedBatchConsumer*:*OmhWriter*:*OmhSafeSave*:*UniformColumns*:*BackgroundJob*:*ResidentSetGovernor*'}
 # halt_on_error: the first race fails the job.
 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
   LD_LIBRARY_PATH="$tbb_prefix/lib" ./build/tsan/bin/omicron_core_tests --gtest_filter="$filter"

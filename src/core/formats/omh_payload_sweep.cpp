@@ -1,10 +1,10 @@
 #include "formats/omh_payload_sweep.hpp"
 
+#include "formats/background_job.hpp"
 #include "formats/omh_record_sink.hpp"
 
 #include <algorithm>
 #include <array>
-#include <future>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
@@ -189,7 +189,7 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
         }
         encoder.finish(); // before the batch's splats are reused
     };
-    std::future<void> writing; // of the previous batch; its destructor waits for it
+    BackgroundJob writing; // of the previous batch; its destructor waits for it
     tbb::enumerable_thread_specific<SplatScratch> scratch;
 
     const std::vector<std::uint64_t>& rootPoints = subtrees[static_cast<std::size_t>(firstLevel)];
@@ -206,17 +206,14 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
     // A built hierarchy's subtrees cover one stretch of the cloud: read it in bulk, on a
     // thread of its own (the kernel submits a read-ahead's reads as it goes, and waits when the
     // device's queue is full), one batch ahead of the estimation. No-op in memory.
-    std::future<void> reading; // the read-ahead in flight; its destructor waits for it
+    BackgroundJob reading; // the read-ahead in flight; its destructor waits for it
     const auto readAhead = [&](std::size_t begin, std::size_t end) {
         if (!cloud.fileBacked()) {
             return;
         }
-        if (reading.valid()) {
-            reading.get();
-        }
         const std::uint64_t from = hierarchy.node(firstLevel, begin).coveredBegin;
         const std::uint64_t to = coveredEnd(hierarchy.node(firstLevel, end - 1));
-        reading = std::async(std::launch::async, [&cloud, from, to] { cloud.willRead(from, to); });
+        reading.start([&cloud, from, to] { cloud.willRead(from, to); });
     };
     std::size_t end = roots > 0 ? batchEnd(0) : 0;
     if (roots > 0) {
@@ -254,16 +251,12 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
         if (afterRead) { // the batch's pages are in memory: the estimation read them
             afterRead(coveredEnd(hierarchy.node(firstLevel, end - 1)));
         }
-        if (writing.valid()) {
-            writing.get(); // the previous batch is written (or its error is thrown here)
-        }
-        writing = std::async(std::launch::async, [&write, &batch] { write(batch); });
+        // The previous batch is written (or its error is thrown here) before this one starts.
+        writing.start([&write, &batch] { write(batch); });
         begin = end;
         end = nextEnd;
     }
-    if (writing.valid()) {
-        writing.get();
-    }
+    writing.wait();
     for (int level = firstLevel; level < levelCount; ++level) {
         levels[static_cast<std::size_t>(level)].payloadChecksum =
             sinks[static_cast<std::size_t>(level - firstLevel)].finishSection();
