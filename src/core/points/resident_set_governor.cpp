@@ -46,14 +46,24 @@ ResidentSetGovernor::Look ResidentSetGovernor::look() {
     // pages have grown by that much since. Each drop unmaps pages on every core (a TLB
     // shootdown), and a save of many small batches looked before each one: with a drop every
     // time, 28k batches over lion.ply under 4 MiB spent most of the save in madvise.
-    if (resident.fileBackedBytes < m_afterDrop.load(std::memory_order_relaxed) + worthDropping) {
+    // What a drop left is measured again at each drop, since other threads may fault pages
+    // back in meanwhile; it counts up to an eighth above the least ever left, so such a
+    // measure cannot let the cloud's pages grow by more than twice that (the least ever left
+    // alone kept the save of 1-point batches at 20 s, not 10).
+    const std::uint64_t left =
+        std::min(m_afterDrop.load(std::memory_order_relaxed),
+                 m_leastAfterDrop.load(std::memory_order_relaxed) + worthDropping);
+    if (resident.fileBackedBytes < left + worthDropping) {
         return Look::Under;
     }
     m_drop(); // two threads dropping at once is harmless: the pages are just unmapped
     m_drops.fetch_add(1, std::memory_order_relaxed);
-    // Measured again at each drop: pages faulted back in meanwhile raise it for one round
-    // at most (the least ever seen instead kept the save of 1-point batches at 20 s, not 10).
-    m_afterDrop.store(processResidentSet().fileBackedBytes, std::memory_order_relaxed);
+    const std::uint64_t after = processResidentSet().fileBackedBytes;
+    m_afterDrop.store(after, std::memory_order_relaxed);
+    std::uint64_t least = m_leastAfterDrop.load(std::memory_order_relaxed);
+    while ((least == 0 || after < least) &&
+           !m_leastAfterDrop.compare_exchange_weak(least, after, std::memory_order_relaxed)) {
+    }
     return Look::Dropped;
 }
 

@@ -43,8 +43,9 @@ private:
     std::uint64_t m_limit;
     std::function<void()> m_drop;
     std::atomic<std::uint64_t> m_drops{0};
-    // File-backed resident bytes right after the last drop (0: none yet).
+    // File-backed resident bytes right after the last drop, and the least ever (0: no drop yet).
     std::atomic<std::uint64_t> m_afterDrop{0};
+    std::atomic<std::uint64_t> m_leastAfterDrop{0};
     std::mutex m_mutex;
     std::condition_variable m_wake;
     bool m_stop = false;

@@ -62,9 +62,12 @@ TEST(ResidentSetGovernor, DropsAgainOnlyOnceTheMappingsPagesCameBack) {
     test::TempDir dir;
     const FileMapping mapping(dir.file("cloud.bin"));
     ASSERT_GT(processResidentSet().bytes, kLimit) << "the process is under the budget";
+    mapping.touch(); // before the governor's first look: a drop amid the touch is followed by
+                     // another for the pages touched after it
     ResidentSetGovernor governor(kLimit, [&] { mapping.drop(); });
-    mapping.touch();
     ASSERT_TRUE(dropsBeyond(governor, 0)) << "16 MiB of file pages over a 4 MiB budget stayed";
+    // A look that raced with the first drop (the thread's and ours) has finished.
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
 
     // Nothing touched: still over the budget (by the program's own pages), but nothing that a
     // drop would give back. 50 looks of the thread's, and 25 of our own.
