@@ -1,7 +1,7 @@
 // One job at a time on a thread of its own, the thread kept from job to job. The `.omh`
 // sweep hands each batch's write and the next stretch's read-ahead to such a thread; started
-// per batch with std::async, a sweep of small batches spent most of its time creating
-// threads (28k batches of one root over lion.ply: 160 us each, the save 5x slower).
+// per batch with std::async, a sweep of small batches spent much of its time creating threads
+// (lion.ply saved in 28k batches of one root: 4.7 s, 2.9 s with this).
 #pragma once
 
 #include <condition_variable>

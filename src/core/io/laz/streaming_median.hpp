@@ -27,6 +27,8 @@ public:
         const std::int32_t s1 = high ? v[1] : v[2];
         const std::int32_t s2 = high ? v[2] : v[3];
         const std::int32_t s3 = high ? v[3] : v[4];
+        // LASzip's switch: replacing at the high end, a value not below the middle switches
+        // to the low end; replacing at the low end, a value not above it to the high end.
         m_replaceHigh = value < v[2] || (!high && value == v[2]);
         v[0] = std::min(s0, value);
         v[1] = std::max(s0, std::min(s1, value));
