@@ -24,11 +24,6 @@ void Point14Decoder::start(const std::uint8_t* firstItem, std::uint32_t channel,
     m_contexts.open(m_contexts.current, Fields::load(firstItem));
 }
 
-void Point14Decoder::decode(std::uint8_t* item, std::uint32_t /*channel*/) {
-    std::uint8_t channel = 0;
-    decode(item, 1, kPoint14Bytes, &channel);
-}
-
 void Point14Decoder::decode(std::uint8_t* items, std::size_t count, std::size_t stride,
                             std::uint8_t* channels) {
     const std::uint32_t startChannel = m_contexts.current;

@@ -14,16 +14,16 @@ namespace omicron::laz {
 inline constexpr std::size_t kPoint14Bytes = 30;
 inline constexpr std::size_t kPoint14Layers = 9;
 
-class Point14Decoder final : public LayeredItemDecoder {
+// Not a LayeredItemDecoder: the chunk decoder calls it first, for a slice of points at once,
+// and the other items follow the channels it reports.
+class Point14Decoder {
 public:
     Point14Decoder();
-    ~Point14Decoder() override;
+    ~Point14Decoder();
 
-    std::size_t layerCount() const override { return kPoint14Layers; }
-    void start(const std::uint8_t* firstItem, std::uint32_t channel,
-               std::span<Layer> layers) override;
-    // `channel` is ignored: POINT14 decodes it (the decode() below reports each point's).
-    void decode(std::uint8_t* item, std::uint32_t channel) override;
+    // Starts a chunk from its first point's item (stored raw) in scanner channel `channel`;
+    // the kPoint14Layers `layers` (already started over their bytes) outlive the decoder.
+    void start(const std::uint8_t* firstItem, std::uint32_t channel, std::span<Layer> layers);
     // Decodes the next `count` points into the items at `items`, `stride` bytes apart, a layer
     // at a time over all of them (each layer is its own stream: one stream's loop keeps its
     // state and branch history to itself); `channels` receives each point's scanner channel.
