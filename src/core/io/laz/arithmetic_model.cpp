@@ -19,7 +19,7 @@ SymbolModel::SymbolModel(std::uint32_t symbolCountIn)
         }
         tableSize = std::uint32_t{1} << tableBits;
         tableShift = kSymbolLengthShift - tableBits;
-        decoderTable.resize(tableSize + 2);
+        decoderTable.resize(tableSize + 2 + kTableFillRun);
     }
     // The first update turns the unit counts into a uniform distribution (total = symbols).
     update();
@@ -45,14 +45,23 @@ void SymbolModel::update() {
             sum += symbolCount[k];
         }
     } else {
+        // Slots (filled, slot] go to symbol k - 1. A fixed run of kTableFillRun stores covers
+        // them without a data-dependent loop (a symbol spans about four slots, so the loop's
+        // exit was a mispredicted branch per symbol); the slots it writes past `slot` are
+        // written again by the later symbol or the tail below that owns them.
+        std::uint32_t* table = decoderTable.data();
         std::uint32_t filled = 0;
         for (std::uint32_t k = 0; k < symbols; ++k) {
             distribution[k] = (scale * sum) >> (31 - kSymbolLengthShift);
             sum += symbolCount[k];
             const std::uint32_t slot = distribution[k] >> tableShift;
-            while (filled < slot) {
-                decoderTable[++filled] = k - 1;
+            for (std::uint32_t i = 1; i <= kTableFillRun; ++i) {
+                table[filled + i] = k - 1;
             }
+            for (std::uint32_t i = filled + kTableFillRun + 1; i <= slot; ++i) {
+                table[i] = k - 1;
+            }
+            filled = slot > filled ? slot : filled;
         }
         decoderTable[0] = 0;
         while (filled <= tableSize) {

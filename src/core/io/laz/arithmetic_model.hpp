@@ -20,6 +20,9 @@ inline constexpr std::uint32_t kBitMaxCount = std::uint32_t{1} << kBitLengthShif
 
 inline constexpr std::uint32_t kMaxSymbols = 2048;
 
+// SymbolModel::update fills the decoder table in runs of this many slots (see there).
+inline constexpr std::uint32_t kTableFillRun = 8;
+
 // An adaptive model over `symbols` symbols (2 to kMaxSymbols). The decoder reads the public
 // fields directly: they are the model's whole state.
 struct SymbolModel {

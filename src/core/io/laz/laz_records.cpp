@@ -4,6 +4,7 @@
 #include "io/laz/chunk_table.hpp"
 #include "io/laz/copc_hierarchy.hpp"
 #include "io/laz/laszip_vlr.hpp"
+#include "io/scratch_bytes.hpp"
 
 #include <algorithm>
 #include <exception>
@@ -61,7 +62,8 @@ public:
             if (decodedBytes(c) > m_streaming.batchBytes) {
                 continue;
             }
-            const std::vector<std::uint8_t> bytes = readChunks(c, c + 1);
+            ScratchBytes compressed;
+            const std::span<const std::uint8_t> bytes = readChunks(c, c + 1, compressed);
             laz::ChunkDecoder decoder(m_vlr);
             decoder.start(bytes, context(c));
             records.resize(static_cast<std::size_t>(decodedBytes(c)));
@@ -114,7 +116,8 @@ public:
         std::uint64_t visited = std::min(spread, maxRecords);
         const std::uint64_t prefix = std::min(chunks[0].pointCount, maxRecords - visited + 1);
         if (prefix > 1 && decodedBytes(0) <= m_streaming.batchBytes) {
-            const std::vector<std::uint8_t> bytes = readChunks(0, 1);
+            ScratchBytes compressed;
+            const std::span<const std::uint8_t> bytes = readChunks(0, 1, compressed);
             laz::ChunkDecoder decoder(m_vlr);
             decoder.start(bytes, context(0));
             std::vector<std::uint8_t> records(prefix * m_header.recordLength);
@@ -176,11 +179,13 @@ private:
         return after == chunks.begin() ? chunks.front() : *(after - 1);
     }
 
-    // The compressed bytes of chunks [first, end): contiguous in the file, one read.
-    std::vector<std::uint8_t> readChunks(std::size_t first, std::size_t end) {
+    // The compressed bytes of chunks [first, end): contiguous in the file, one read into `into`.
+    std::span<const std::uint8_t> readChunks(std::size_t first, std::size_t end,
+                                             ScratchBytes& into) {
         const laz::Chunk& last = m_layout.chunks[end - 1];
         const std::uint64_t begin = m_layout.chunks[first].offset;
-        std::vector<std::uint8_t> bytes(static_cast<std::size_t>(last.offset + last.bytes - begin));
+        const std::span<std::uint8_t> bytes =
+            into.take(static_cast<std::size_t>(last.offset + last.bytes - begin));
         m_stream->seek(begin);
         m_stream->readExact(bytes.data(), bytes.size(),
                             "LAZ chunks " + std::to_string(first) + " to " +
@@ -192,13 +197,15 @@ private:
     // reported after every chunk before it was delivered, so the error does not depend on
     // which thread finished first.
     bool decodeBatch(std::size_t first, std::size_t end, const BlockVisitor& visit) {
-        const std::vector<std::uint8_t> compressed = readChunks(first, end);
+        const std::span<const std::uint8_t> compressed = readChunks(first, end, m_compressed);
         const std::uint64_t base = m_layout.chunks[first].offset;
         std::vector<std::uint64_t> recordStart(end - first + 1, 0);
         for (std::size_t c = first; c < end; ++c) {
             recordStart[c - first + 1] = recordStart[c - first] + decodedBytes(c);
         }
-        std::vector<std::uint8_t> records(static_cast<std::size_t>(recordStart.back()));
+        // Every byte is written by its chunk's decoder; a chunk that fails is never visited.
+        const std::span<std::uint8_t> records =
+            m_records.take(static_cast<std::size_t>(recordStart.back()));
         std::vector<std::exception_ptr> errors(end - first);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(first, end, 1),
                           [&](const tbb::blocked_range<std::size_t>& range) {
@@ -233,12 +240,12 @@ private:
     // compressed bytes (at most the file) and one slice of records at a time.
     bool streamLargeChunk(std::size_t c, const BlockVisitor& visit) {
         const laz::Chunk& chunk = m_layout.chunks[c];
-        const std::vector<std::uint8_t> compressed = readChunks(c, c + 1);
+        const std::span<const std::uint8_t> compressed = readChunks(c, c + 1, m_compressed);
         laz::ChunkDecoder decoder(m_vlr);
         decoder.start(compressed, context(c));
         const std::uint64_t sliceRecords =
             std::max<std::uint64_t>(1, m_streaming.sliceBytes / m_header.recordLength);
-        std::vector<std::uint8_t> records(static_cast<std::size_t>(
+        const std::span<std::uint8_t> records = m_records.take(static_cast<std::size_t>(
             std::min(sliceRecords, chunk.pointCount) * m_header.recordLength));
         for (std::uint64_t done = 0; done < chunk.pointCount;) {
             const std::uint64_t count = std::min(sliceRecords, chunk.pointCount - done);
@@ -260,6 +267,9 @@ private:
     laz::LaszipVlr m_vlr;
     laz::ChunkLayout m_layout;
     std::optional<laz::CopcInfo> m_copc; // a COPC file's info record
+    // Kept from batch to batch: a LAZ file of many batches faults its buffers in once.
+    ScratchBytes m_compressed;
+    ScratchBytes m_records;
 };
 
 } // namespace

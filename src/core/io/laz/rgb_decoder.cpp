@@ -7,16 +7,6 @@ static_assert(std::endian::native == std::endian::little, "LAS fields are stored
 
 namespace omicron::laz {
 
-Rgb loadRgb(const std::uint8_t* bytes) {
-    Rgb rgb;
-    std::memcpy(rgb.data(), bytes, sizeof rgb);
-    return rgb;
-}
-
-void storeRgb(std::uint8_t* bytes, const Rgb& rgb) {
-    std::memcpy(bytes, rgb.data(), sizeof rgb);
-}
-
 void Rgb12Decoder::start(const std::uint8_t* item) {
     m_last = loadRgb(item);
 }

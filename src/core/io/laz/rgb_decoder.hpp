@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <cstring>
 
 namespace omicron::laz {
 
@@ -87,8 +88,16 @@ inline Rgb decodeRgb(ArithmeticDecoder& decoder, RgbModels& models, const Rgb& l
     return rgb;
 }
 
-Rgb loadRgb(const std::uint8_t* bytes);
-void storeRgb(std::uint8_t* bytes, const Rgb& rgb);
+// Inline: RGB14's layer loop calls them for every point.
+inline Rgb loadRgb(const std::uint8_t* bytes) {
+    Rgb rgb;
+    std::memcpy(rgb.data(), bytes, sizeof rgb);
+    return rgb;
+}
+
+inline void storeRgb(std::uint8_t* bytes, const Rgb& rgb) {
+    std::memcpy(bytes, rgb.data(), sizeof rgb);
+}
 
 // The RGB12 item, version 2: three little-endian uint16.
 class Rgb12Decoder final : public PointwiseItemDecoder {
