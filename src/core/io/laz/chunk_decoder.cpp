@@ -248,8 +248,8 @@ void ChunkDecoder::decodePointwise(std::uint8_t* records, std::uint64_t count) {
     }
 }
 
-// An item at a time over the points (POINT14 a layer at a time), not a point at a time over the
-// items: the layers are independent streams (the other items only need each point's scanner
+// An item at a time over the points (POINT14 a few layers at a time), not a point at a time over
+// the items: the layers are independent streams (the other items only need each point's scanner
 // channel from POINT14), and one stream's loop keeps its state and branch history to itself.
 void ChunkDecoder::decodeLayered(std::uint8_t* records, std::uint64_t count) {
     m_channels.resize(count);

@@ -154,15 +154,14 @@ void Point14Decoder::decode(std::uint8_t* items, std::size_t count, std::size_t 
         }
         storeRaw(item + 22, c.last.gpsTimeBits);
     };
-    // A loop per layer: each is one stream's dependency chain, and in a loop of its own the
-    // chain's state and branches stay predictable.
-    decodeLayers(items, count, stride, startChannel, zField);
-    decodeLayers(items, count, stride, startChannel, classificationField);
-    decodeLayers(items, count, stride, startChannel, flagsField);
-    decodeLayers(items, count, stride, startChannel, intensityField);
-    decodeLayers(items, count, stride, startChannel, scanAngleField);
-    decodeLayers(items, count, stride, startChannel, userDataField);
-    decodeLayers(items, count, stride, startChannel, pointSourceField);
+    // A few layers per loop: each layer is one stream's dependency chain, and the chains of
+    // one loop overlap. Grouped by weight: the two integer layers, the one-symbol layers (scan
+    // angle and point source mostly unchanged), GPS time alone (its branches are its own).
+    // terrascan_fmt8.laz on a Zen 4 host: 3 % faster than a loop per layer, 1 % faster than
+    // one loop for all (on the Zen 5 host before, a loop per layer beat one for all by 2 %).
+    decodeLayers(items, count, stride, startChannel, zField, intensityField);
+    decodeLayers(items, count, stride, startChannel, classificationField, flagsField, userDataField,
+                 scanAngleField, pointSourceField);
     decodeLayers(items, count, stride, startChannel, gpsTimeField);
     m_layers[kZ].decoder = zDecoder;
     m_layers[kClassification].decoder = classDecoder;

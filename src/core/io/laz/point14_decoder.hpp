@@ -24,9 +24,9 @@ public:
     // Starts a chunk from its first point's item (stored raw) in scanner channel `channel`;
     // the kPoint14Layers `layers` (already started over their bytes) outlive the decoder.
     void start(const std::uint8_t* firstItem, std::uint32_t channel, std::span<Layer> layers);
-    // Decodes the next `count` points into the items at `items`, `stride` bytes apart, a layer
-    // at a time over all of them (each layer is its own stream: one stream's loop keeps its
-    // state and branch history to itself); `channels` receives each point's scanner channel.
+    // Decodes the next `count` points into the items at `items`, `stride` bytes apart, the
+    // first layer over all of them, then the other layers a few at a time over all of them
+    // (each layer is its own stream); `channels` receives each point's scanner channel.
     void decode(std::uint8_t* items, std::size_t count, std::size_t stride, std::uint8_t* channels);
 
     // The scanner channel stored in a raw POINT14 item.
