@@ -22,13 +22,14 @@ float signNotZero(float v) {
 
 } // namespace
 
-std::uint32_t encodeOctahedral(const glm::vec3& unitNormal) {
-    const float sum = std::abs(unitNormal.x) + std::abs(unitNormal.y) + std::abs(unitNormal.z);
+std::uint32_t encodeOctahedral(const glm::vec3& normal) {
+    const float sum = std::abs(normal.x) + std::abs(normal.y) + std::abs(normal.z);
     if (!(sum > 0.0f)) {
         return kUnknownNormal;
     }
-    float x = unitNormal.x / sum, y = unitNormal.y / sum;
-    if (unitNormal.z < 0.0f) {
+    const float inverse = 1.0f / sum;
+    float x = normal.x * inverse, y = normal.y * inverse;
+    if (normal.z < 0.0f) {
         const float fx = (1.0f - std::abs(y)) * signNotZero(x);
         const float fy = (1.0f - std::abs(x)) * signNotZero(y);
         x = fx;

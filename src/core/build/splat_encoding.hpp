@@ -10,8 +10,9 @@
 
 namespace omicron {
 
-// Octahedral encoding of a unit vector in 2 x 16 bits (x in the low half).
-std::uint32_t encodeOctahedral(const glm::vec3& unitNormal);
+// Octahedral encoding of a direction in 2 x 16 bits (x in the low half): of `normal`
+// divided by its L1 norm, so any non-zero length will do.
+std::uint32_t encodeOctahedral(const glm::vec3& normal);
 glm::vec3 decodeOctahedral(std::uint32_t encoded);
 // Stored where no normal could be estimated (fewer than 3 points, or all on a line); decodes
 // to (0, 0, 0): the renderer draws a screen-aligned splat there.

@@ -84,25 +84,29 @@ CellEstimate estimateCell(const SplatScratch::Moments& m, double density, double
     glm::vec3 v = a00 >= a11 && a00 >= a22 ? glm::vec3(a00, a01, a02)
                   : a11 >= a22             ? glm::vec3(a01, a11, a12)
                                            : glm::vec3(a02, a12, a22);
+    // Only the direction matters, to the power steps and to the octahedral code (which
+    // divides by the L1 norm itself): each step rescales by the largest component (one
+    // division, to keep the floats far from underflow), and no step takes a square root.
+    // Unit lengths at each step and at the end (three roots, nine divisions) made every
+    // node's estimate of autzen_south 7 % slower.
     for (int step = 0; step < 2; ++step) {
-        const float length = std::sqrt(glm::dot(v, v));
-        if (!(length > 0.0f)) {
+        const float largest = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+        if (!(largest > 0.0f) || !std::isfinite(largest)) {
             return estimate;
         }
-        v /= length;
+        v *= 1.0f / largest;
         v = glm::vec3(a00 * v.x + a01 * v.y + a02 * v.z, a01 * v.x + a11 * v.y + a12 * v.z,
                       a02 * v.x + a12 * v.y + a22 * v.z);
     }
-    const float length = std::sqrt(glm::dot(v, v));
-    if (!(length > 0.0f) || !std::isfinite(length)) {
+    const float norm1 = std::abs(v.x) + std::abs(v.y) + std::abs(v.z);
+    if (!(norm1 > 0.0f) || !std::isfinite(norm1)) {
         return estimate;
     }
-    glm::vec3 n = v / length;
     // PCA gives no side; up (+z) is the common convention for scans (terrain, buildings).
-    if (n.z < 0.0f) {
-        n = -n;
+    if (v.z < 0.0f) {
+        v = -v;
     }
-    estimate.normal = encodeOctahedral(n);
+    estimate.normal = encodeOctahedral(v);
     return estimate;
 }
 
