@@ -63,9 +63,9 @@ void SymbolModel::update() {
             }
             filled = slot > filled ? slot : filled;
         }
-        decoderTable[0] = 0;
+        table[0] = 0;
         while (filled <= tableSize) {
-            decoderTable[++filled] = symbols - 1;
+            table[++filled] = symbols - 1;
         }
     }
     updateCycle = (5 * updateCycle) >> 2;

@@ -42,6 +42,7 @@ public:
             laz::readCopcTopNodes(*m_stream, *m_copc, maxRecords);
         const std::vector<laz::Chunk>& chunks = m_layout.chunks;
         std::uint64_t visited = 0;
+        ScratchBytes compressed;
         std::vector<std::uint8_t> records;
         for (const laz::CopcNode& node : nodes) {
             const auto chunk = std::lower_bound(
@@ -62,7 +63,6 @@ public:
             if (decodedBytes(c) > m_streaming.batchBytes) {
                 continue;
             }
-            ScratchBytes compressed;
             const std::span<const std::uint8_t> bytes = readChunks(c, c + 1, compressed);
             laz::ChunkDecoder decoder(m_vlr);
             decoder.start(bytes, context(c));
