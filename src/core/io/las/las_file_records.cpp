@@ -1,6 +1,7 @@
 #include "io/las/las_file_records.hpp"
 
 #include <algorithm>
+#include <tbb/task_group.h>
 
 namespace omicron {
 
@@ -15,17 +16,49 @@ LasFileRecords::LasFileRecords(std::unique_ptr<FileStream> stream, const las::He
 void LasFileRecords::forEachBlock(const BlockVisitor& visit) {
     const std::uint64_t stride = m_header.recordLength;
     const std::uint64_t recordsPerBlock = std::max<std::uint64_t>(1, kBlockBytes / stride);
-    m_block.resize(static_cast<std::size_t>(recordsPerBlock * stride));
+    for (std::vector<std::uint8_t>& block : m_blocks) {
+        block.resize(static_cast<std::size_t>(recordsPerBlock * stride));
+    }
     m_stream->seek(m_header.pointDataOffset);
-    for (std::uint64_t first = 0; first < m_header.pointCount; first += recordsPerBlock) {
+    const auto readBlock = [&](std::uint64_t first) {
         const std::uint64_t count = std::min(recordsPerBlock, m_header.pointCount - first);
-        m_stream->readExact(m_block.data(), static_cast<std::size_t>(count * stride),
+        std::vector<std::uint8_t>& block = m_blocks[(first / recordsPerBlock) % 2];
+        m_stream->readExact(block.data(), static_cast<std::size_t>(count * stride),
                             "point records " + std::to_string(first) + " to " +
                                 std::to_string(first + count - 1) + " (counting from 0, " +
                                 std::to_string(stride) + " bytes each)");
-        if (!visit({m_block.data(), count, first, m_header.recordOffset(first + count)})) {
+    };
+    // Block k + 1 is read (a copy out of the page cache, as long as parsing block k) while
+    // block k is visited, by a worker thread where one is free.
+    tbb::task_group readAhead;
+    const auto finishReadAhead = [&readAhead] {
+        try {
+            readAhead.wait();
+        } catch (...) { // the visit's error, which came first, is the one reported
+        }
+    };
+    if (m_header.pointCount > 0) {
+        readBlock(0);
+    }
+    for (std::uint64_t first = 0; first < m_header.pointCount; first += recordsPerBlock) {
+        const std::uint64_t count = std::min(recordsPerBlock, m_header.pointCount - first);
+        const std::uint64_t next = first + recordsPerBlock;
+        if (next < m_header.pointCount) {
+            readAhead.run([&readBlock, next] { readBlock(next); });
+        }
+        bool more;
+        try {
+            more = visit({m_blocks[(first / recordsPerBlock) % 2].data(), count, first,
+                          m_header.recordOffset(first + count)});
+        } catch (...) {
+            finishReadAhead();
+            throw;
+        }
+        if (!more) {
+            finishReadAhead();
             return;
         }
+        readAhead.wait(); // rethrows the next block's read error
     }
 }
 

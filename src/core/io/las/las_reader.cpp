@@ -2,8 +2,8 @@
 
 #include "io/file_stream.hpp"
 #include "io/input_error.hpp"
-#include "io/las/las_file_records.hpp"
 #include "io/las/las_extra_bytes.hpp"
+#include "io/las/las_file_records.hpp"
 #include "io/las/las_header.hpp"
 #include "io/las/las_point_fields.hpp"
 #include "io/laz/laz_records.hpp"
@@ -12,11 +12,14 @@
 #include "io/source_normalizer.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 static_assert(std::endian::native == std::endian::little,
               "LAS records are little-endian and are decoded with memcpy loads");
@@ -27,6 +30,9 @@ namespace {
 
 // How many records, spread evenly over the file, decide the colour depth.
 constexpr std::uint64_t kColorSampleRecords = 4096;
+// Records a parse slice holds at least: a few hundred microseconds of work, so a slice costs
+// far more than handing it to another thread.
+constexpr std::size_t kParseSlicePoints = 8192;
 
 // LAS stores colour in 16-bit fields, but many writers put 8-bit values there unscaled.
 enum class ColorDepth {
@@ -273,19 +279,44 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
                 sizeColumns(at + take); // more records than the header declared
             }
             const std::uint8_t* records = block.records + i * stride;
-            // The bounds test is folded into one flag per run, so the loop has no branch; the
-            // first point out of bounds is found again for its error.
-            glm::vec3* positions = batch.positions.data() + at;
-            std::uint16_t* intensities = batch.intensities.data() + at;
-            bool allInBounds = true;
-            for (std::size_t j = 0; j < take; ++j) {
-                const std::uint8_t* record = records + j * stride;
-                const glm::dvec3 source = sourcePosition(record, scale, offset);
-                allInBounds &= normalizer.inBounds(source);
-                positions[j] = normalizer.toUnit(glm::clamp(source, low, high));
-                intensities[j] = loadRaw<std::uint16_t>(record + las::kRecordIntensity);
+            // A run is parsed in slices on the worker threads: the sorter's thread, which
+            // consumes the batches, waits for the parse about half of the read phase, and a
+            // slice keeps its core busy meanwhile. The bounds test is folded into one flag per
+            // slice, so the loop has no branch; the first point out of bounds is found again
+            // for its error.
+            std::atomic<bool> allInBounds{true};
+            const auto parseSlice = [&](std::size_t first, std::size_t last) {
+                glm::vec3* positions = batch.positions.data() + at;
+                std::uint16_t* intensities = batch.intensities.data() + at;
+                bool sliceInBounds = true;
+                for (std::size_t j = first; j < last; ++j) {
+                    const std::uint8_t* record = records + j * stride;
+                    const glm::dvec3 source = sourcePosition(record, scale, offset);
+                    sliceInBounds &= normalizer.inBounds(source);
+                    positions[j] = normalizer.toUnit(glm::clamp(source, low, high));
+                    intensities[j] = loadRaw<std::uint16_t>(record + las::kRecordIntensity);
+                }
+                if (!sliceInBounds) {
+                    allInBounds.store(false, std::memory_order_relaxed);
+                }
+                if (hasColor) {
+                    glm::u8vec3* colors = batch.colors.data() + at;
+                    for (std::size_t j = first; j < last; ++j) {
+                        colors[j] = color(records + j * stride + colorOffset, sixteenBitColor);
+                    }
+                }
+                las::readLasColumns(records + first * stride, last - first, stride, pointFormat,
+                                    lasLayout, batch.las.data() + (at + first) * lasBytes);
+            };
+            if (take >= 2 * kParseSlicePoints) {
+                tbb::parallel_for(tbb::blocked_range<std::size_t>(0, take, kParseSlicePoints),
+                                  [&](const tbb::blocked_range<std::size_t>& slice) {
+                                      parseSlice(slice.begin(), slice.end());
+                                  });
+            } else {
+                parseSlice(0, take);
             }
-            if (!allInBounds) {
+            if (!allInBounds.load(std::memory_order_relaxed)) {
                 for (std::size_t j = 0; j < take; ++j) {
                     const glm::dvec3 source = sourcePosition(records + j * stride, scale, offset);
                     if (!normalizer.inBounds(source)) {
@@ -293,14 +324,6 @@ ReadSummary LasReader::read(const BatchConsumer& consumer, const ReadOptions& op
                     }
                 }
             }
-            if (hasColor) {
-                glm::u8vec3* colors = batch.colors.data() + at;
-                for (std::size_t j = 0; j < take; ++j) {
-                    colors[j] = color(records + j * stride + colorOffset, sixteenBitColor);
-                }
-            }
-            las::readLasColumns(records, take, stride, pointFormat, lasLayout,
-                                batch.las.data() + at * lasBytes);
             filled += take;
             i += take;
             if (filled == batchPoints) {

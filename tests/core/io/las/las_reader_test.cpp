@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <functional>
 #include <gtest/gtest.h>
 #include <limits>
@@ -443,6 +444,66 @@ TEST(LasReaderTest, PointOutsideTheBoundsInALaterBatchNamesItsRecord) {
             << error.what();
     }
     EXPECT_EQ(delivered, 128u) << "the two whole batches before it, nothing of the third";
+}
+
+// A file of several 4 MiB blocks, each read while the one before is parsed, in batches whose
+// runs are parsed in slices on several threads: every point arrives once, in file order, with
+// its own attributes.
+constexpr std::size_t kManyBlocksPoints = 300000; // 34-byte records: 10.2 MB, three blocks
+
+TEST(LasReaderTest, FileOfSeveralBlocksArrivesInOrderWithEveryAttribute) {
+    test::TempDir dir;
+    const std::string path = dir.file("blocks.las");
+    writeValidLas(path, 2, 3, kManyBlocksPoints);
+    const ReadBack back = readAll(path);
+    ASSERT_EQ(back.summary.pointsDelivered, kManyBlocksPoints);
+    ASSERT_EQ(back.points.size(), kManyBlocksPoints);
+    expectInUnitCube(back.points.positions);
+    // The writer's random source positions again (same seed and order as writeValidLas).
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::vector<glm::dvec3> source(kManyBlocksPoints);
+    for (glm::dvec3& p : source) {
+        p = kOffset + glm::dvec3(50.0 * unit(random), 40.0 * unit(random), 10.0 * unit(random));
+    }
+    const CubeTransform& cube = back.info.cube;
+    for (std::size_t i = 0; i < kManyBlocksPoints; ++i) {
+        ASSERT_EQ(back.points.intensities[i], static_cast<std::uint16_t>(i)) << "point " << i;
+        ASSERT_EQ(back.points.colors[i], glm::u8vec3(i % 256, (3 * i) % 256, 255)) << "point " << i;
+        const glm::dvec3 read = cube.toSource(back.points.positions[i]);
+        ASSERT_NEAR(read.x, source[i].x, 0.002) << "point " << i;
+        ASSERT_NEAR(read.y, source[i].y, 0.002) << "point " << i;
+        ASSERT_NEAR(read.z, source[i].z, 0.002) << "point " << i;
+    }
+}
+
+TEST(LasReaderTest, PointOutsideTheBoundsInALaterBlockNamesItsRecord) {
+    test::TempDir dir;
+    const std::string path = dir.file("outside-block.las");
+    std::vector<std::uint8_t> bytes = writeValidLas(path, 2, 3, kManyBlocksPoints);
+    const std::size_t index = 250001; // third block, in a slice after the run's first
+    const std::size_t record = pointDataOffset(bytes) + index * 34;
+    put<std::int32_t>(bytes, record + 8, get<std::int32_t>(bytes, record + 8) + 20000);
+    test::writeBytes(path, bytes);
+    expectInputError([&] { readAll(path); }, InputErrorKind::OutOfBounds, path, record);
+}
+
+TEST(LasReaderTest, FileCutWhileBeingReadNamesTheRecordsItLacks) {
+    test::TempDir dir;
+    const std::string path = dir.file("cut.las");
+    const std::vector<std::uint8_t> bytes = writeValidLas(path, 2, 3, kManyBlocksPoints);
+    auto reader = openLasReader(path, {}); // the header's count matches the file's size here
+    const std::uint64_t keep = pointDataOffset(bytes) + 200000 * std::uint64_t{34};
+    std::filesystem::resize_file(path, keep); // another program cuts it short meanwhile
+    std::size_t delivered = 0;
+    try {
+        reader->read([&](const PointBatch& batch) { delivered += batch.size(); });
+        FAIL() << "expected Truncated";
+    } catch (const InputError& error) {
+        EXPECT_EQ(error.kind(), InputErrorKind::Truncated) << error.what();
+        EXPECT_NE(error.detail().find("point records"), std::string::npos) << error.what();
+    }
+    EXPECT_LT(delivered, 200000u) << "nothing past the end of what was left";
 }
 
 TEST(LasReaderTest, KnownBoundsThatMissAPointFailTheRead) {
