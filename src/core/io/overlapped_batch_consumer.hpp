@@ -3,7 +3,7 @@
 // A reader parses on one thread and, through its callback, also hands every batch to the
 // sorter (codes, bins, the copy into the arrival-order arrays) on that same thread: the read
 // phase took the parse time plus the sorter's, about twice read_bench's parse time for LAS,
-// with the second core mostly idle. Here the callback only copies the batch into a free buffer
+// with the second core mostly idle. Here the callback only swaps the batch with a free buffer
 // (two of them, reused) and computes its points' Morton codes, and returns, so the reader parses
 // batch k + 1 while a worker thread consumes batch k. The codes are the reader thread's share
 // because the sorter's share (bins, the copy into the arrival-order arrays and its page
@@ -41,10 +41,12 @@ public:
     OverlappedBatchConsumer(const OverlappedBatchConsumer&) = delete;
     OverlappedBatchConsumer& operator=(const OverlappedBatchConsumer&) = delete;
 
-    // Reader thread: copies `batch` for the worker and codes its points, waiting while the
-    // worker still has the previous copy. Rethrows what the consumer threw (its later batches
-    // are not consumed).
-    void push(const PointBatch& batch);
+    // Reader thread: hands `batch` to the worker and codes its points, waiting while the
+    // worker still holds the previous one. The batch is taken by swapping it with the buffer
+    // the worker is done with when both have the same attributes and column sizes (every
+    // full batch after the first two: `batch` then holds that buffer's stale points), and
+    // copied otherwise. Rethrows what the consumer threw (its later batches are not consumed).
+    void push(PointBatch& batch);
     // Reader thread, after the last push: waits until every batch is consumed; rethrows what
     // the consumer threw.
     void finish();
@@ -59,7 +61,7 @@ private:
     std::size_t m_pointsPushed = 0; // reader thread only
     std::mutex m_mutex;
     std::condition_variable_any m_changed;
-    PointBatch m_waiting;         // the next batch, copied by push (guarded by m_mutex)
+    PointBatch m_waiting;                     // the next batch, taken by push (guarded by m_mutex)
     std::vector<morton::Code> m_waitingCodes; // its codes (guarded by m_mutex)
     bool m_hasWaiting = false;    // guarded by m_mutex
     bool m_finished = false;      // no more pushes (guarded by m_mutex)

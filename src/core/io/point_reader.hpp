@@ -99,8 +99,11 @@ struct ReadSummary {
     bool cancelled = false;
 };
 
-// Receives each batch; the batch is reused after the call returns.
-using BatchConsumer = std::function<void(const PointBatch&)>;
+// Receives each batch; the batch is reused after the call returns. A consumer may take the
+// batch's columns by swapping it with a batch of the same attributes and column sizes
+// (OverlappedBatchConsumer hands batches to its thread so, without copying them): a reader
+// relies on neither a delivered batch's contents nor its capacity, only on its sizes.
+using BatchConsumer = std::function<void(PointBatch&)>;
 
 class PointReader {
 public:

@@ -339,7 +339,7 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
             return sorter->populateAhead(pointsRead + readOptions.batchPoints);
         });
     const ReadSummary read =
-        reader->read([&](const PointBatch& batch) { sorterInput.push(batch); }, readOptions);
+        reader->read([&](PointBatch& batch) { sorterInput.push(batch); }, readOptions);
     sorterInput.finish();
     result.readSeconds = secondsSince(readStart);
     result.skippedNonFinite = read.skippedNonFinite;

@@ -590,8 +590,7 @@ SortSummary sortPointCloud(PointReader& reader, const SortOptions& options,
         [&](std::size_t pointsRead) {
             return sorter.populateAhead(pointsRead + readOptions.batchPoints);
         });
-    summary.read =
-        reader.read([&](const PointBatch& batch) { sorterInput.push(batch); }, readOptions);
+    summary.read = reader.read([&](PointBatch& batch) { sorterInput.push(batch); }, readOptions);
     sorterInput.finish();
     summary.readSeconds = secondsSince(readStart);
     summary.points = sorter.pointCount();

@@ -53,7 +53,7 @@ TEST(OverlappedBatchConsumer, ConsumesEveryBatchOnceInOrderWithItsContent) {
         std::size_t nextPoint = 0;
         std::vector<std::uint16_t> expectedBatches;
         for (std::size_t k = 0; k < 200; ++k) {
-            const PointBatch batch = batchNumber(k, nextPoint);
+            PointBatch batch = batchNumber(k, nextPoint);
             expectedBatches.insert(expectedBatches.end(), batch.size(),
                                    static_cast<std::uint16_t>(k));
             consumer.push(batch);
@@ -66,6 +66,52 @@ TEST(OverlappedBatchConsumer, ConsumesEveryBatchOnceInOrderWithItsContent) {
         }
         EXPECT_EQ(batchOfPoint, expectedBatches);
         EXPECT_EQ(wrongCodes, 0u);
+    }
+}
+
+// A reader that rewrites one batch in place, as the file readers do: batches of one shape are
+// taken by swapping buffers (the reader's batch comes back as another buffer of the same
+// sizes), and the worker still sees every point once, in order.
+TEST(OverlappedBatchConsumer, BatchesOfOneShapeAreTakenWithoutACopy) {
+    std::vector<float> xs;
+    std::vector<std::uint16_t> batchOfPoint;
+    std::size_t wrongCodes = 0;
+    OverlappedBatchConsumer consumer(
+        [&](const PointBatch& batch, std::span<const morton::Code> codes) {
+            ASSERT_EQ(codes.size(), batch.size());
+            for (std::size_t i = 0; i < batch.size(); ++i) {
+                const glm::vec3& p = batch.positions[i];
+                xs.push_back(p.x);
+                batchOfPoint.push_back(batch.intensities[i]);
+                wrongCodes += codes[i] != morton::encodeUnit(p.x, p.y, p.z) ? 1 : 0;
+            }
+        });
+    constexpr std::size_t kPoints = 64;
+    PointBatch batch;
+    batch.attributes = AttributeSet(Attribute::Intensity);
+    batch.positions.resize(kPoints);
+    batch.intensities.resize(kPoints);
+    std::size_t swapped = 0;
+    for (std::size_t k = 0; k < 100; ++k) {
+        for (std::size_t i = 0; i < kPoints; ++i) { // written in place, every column
+            const auto index = static_cast<float>(k * kPoints + i);
+            batch.positions[i] = glm::vec3(index / 8192.0f, 0.5f, 0.25f);
+            batch.intensities[i] = static_cast<std::uint16_t>(k);
+        }
+        const glm::vec3* before = batch.positions.data();
+        consumer.push(batch);
+        swapped += batch.positions.data() != before ? 1 : 0;
+        ASSERT_EQ(batch.positions.size(), kPoints);
+        ASSERT_EQ(batch.intensities.size(), kPoints);
+        ASSERT_EQ(batch.attributes, AttributeSet(Attribute::Intensity));
+    }
+    consumer.finish();
+    EXPECT_GE(swapped, 98u) << "every batch after the first two is taken, not copied";
+    EXPECT_EQ(wrongCodes, 0u) << "codes of the points the worker got";
+    ASSERT_EQ(xs.size(), 100 * kPoints);
+    for (std::size_t i = 0; i < xs.size(); ++i) {
+        ASSERT_EQ(xs[i], static_cast<float>(i) / 8192.0f) << "point " << i;
+        ASSERT_EQ(batchOfPoint[i], i / kPoints) << "point " << i;
     }
 }
 
@@ -103,7 +149,8 @@ TEST(OverlappedBatchConsumer, TheReaderHelpsWhileTheWorkerHoldsABatch) {
     std::vector<std::size_t> pushedTotals;
     for (std::size_t k = 0; k < 40; ++k) {
         stepsLeft = 3;
-        consumer.push(batchNumber(k, nextPoint));
+        PointBatch batch = batchNumber(k, nextPoint);
+        consumer.push(batch);
         pushedTotals.push_back(nextPoint);
     }
     consumer.finish();
@@ -132,7 +179,8 @@ TEST(OverlappedBatchConsumer, TheConsumersExceptionReachesTheReader) {
     bool thrown = false;
     try {
         for (std::size_t k = 0; k < 1000; ++k) {
-            consumer.push(batchNumber(k, nextPoint));
+            PointBatch batch = batchNumber(k, nextPoint);
+            consumer.push(batch);
         }
         consumer.finish();
     } catch (const std::length_error& error) {
@@ -153,7 +201,8 @@ TEST(OverlappedBatchConsumer, GivingUpPartWayDropsWhatWaitsAndJoins) {
         });
         std::size_t nextPoint = 0;
         for (std::size_t k = 0; k < 3; ++k) {
-            consumer.push(batchNumber(k, nextPoint));
+            PointBatch batch = batchNumber(k, nextPoint);
+            consumer.push(batch);
             ++pushed;
         }
         // The reader threw here: no finish(), the destructor must not hang.

@@ -224,7 +224,8 @@ public:
     ReadSummary read(const BatchConsumer& consumer, const ReadOptions&) override {
         constexpr std::size_t kBatch = 10'000;
         for (std::size_t first = 0; first < m_goodPoints; first += kBatch) {
-            consumer(slice(m_cloud.points, first, std::min(m_goodPoints, first + kBatch)));
+            PointBatch batch = slice(m_cloud.points, first, std::min(m_goodPoints, first + kBatch));
+            consumer(batch);
         }
         m_beforeFailing();
         throw InputError(InputErrorKind::Truncated, m_info.path, InputLocation::byte(1234),
