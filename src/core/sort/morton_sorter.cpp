@@ -30,6 +30,10 @@ double secondsSince(Clock::time_point start) {
 // Runs are sized from half the budget; the rest covers the merge's read buffers, the write
 // block and what the stages after the sort keep.
 constexpr std::uint64_t kMinRunPoints = 4096;
+// The sort's two gathers from the input in arrival order (positions for the keys, then every
+// column into its sorted place) read at random over the whole input: each read is asked for
+// this many points ahead (24.2 M LAS points: the sort 0.339 -> 0.301 s; 128 ahead no better).
+constexpr std::size_t kGatherAhead = 64;
 
 // Gathers the LAS column of points [begin, end) of a sorted range from their input places:
 // `Bytes` known at compile time turns each copy into a few moves instead of a libc call per
@@ -38,6 +42,9 @@ template <std::size_t Bytes>
 void gatherColumn(std::uint8_t* out, const std::uint8_t* in, const std::uint32_t* indices,
                   std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
+        if (i + kGatherAhead < end) {
+            __builtin_prefetch(in + std::size_t{indices[i + kGatherAhead]} * Bytes);
+        }
         std::memcpy(out + i * Bytes, in + std::size_t{indices[i]} * Bytes, Bytes);
     }
 }
@@ -450,6 +457,10 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                        for (std::size_t first = at; first < at + n; first += kKeyBlock) {
                            const std::size_t count = std::min(kKeyBlock, at + n - first);
                            for (std::size_t i = 0; i < count; ++i) {
+                               if (first + i + kGatherAhead < at + n) {
+                                   __builtin_prefetch(
+                                       &m_input.positions[indices[first + i + kGatherAhead]]);
+                               }
                                gathered[i] = m_input.positions[indices[first + i]];
                            }
                            morton::encodeUnitBatch(std::span(gathered.data(), count),
@@ -470,6 +481,21 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, size, 8192),
                                      [&](const tbb::blocked_range<std::size_t>& range) {
                                          for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                                             if (i + kGatherAhead < range.end()) {
+                                                 const std::uint32_t ahead =
+                                                     indices[i + kGatherAhead];
+                                                 __builtin_prefetch(&m_input.positions[ahead]);
+                                                 if (!m_input.normals.empty()) {
+                                                     __builtin_prefetch(&m_input.normals[ahead]);
+                                                 }
+                                                 if (!m_input.colors.empty()) {
+                                                     __builtin_prefetch(&m_input.colors[ahead]);
+                                                 }
+                                                 if (!m_input.intensities.empty()) {
+                                                     __builtin_prefetch(
+                                                         &m_input.intensities[ahead]);
+                                                 }
+                                             }
                                              const std::uint32_t from = indices[i];
                                              out.positions[i] = m_input.positions[from];
                                              if (!m_input.normals.empty()) {
