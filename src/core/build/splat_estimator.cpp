@@ -1,5 +1,6 @@
 #include "build/splat_estimator.hpp"
 
+#include "build/cell_sums.hpp"
 #include "build/parent_sampler.hpp"
 #include "build/splat_encoding.hpp"
 #include "points/unit_cell_box.hpp"
@@ -126,8 +127,9 @@ void sumCellsOf(const Positions& positions, std::uint32_t count, int fineLevel,
     // Sums stay in registers while a cell lasts (appending through the vector each point
     // would force them through memory). Points are tested against the cell's box (no bit
     // interleaving); a cell's code is computed once, when it starts.
-    SplatScratch::Moments current;
+    CellSums current(origin);
     const glm::vec3 firstPoint = positions[pointAt(0)];
+    current.start(firstPoint);
     UnitCellBox currentBox = UnitCellBox::of(firstPoint, fineLevel);
     morton::Code currentCode = cellCode(firstPoint);
     std::uint32_t currentFirst = 0;
@@ -136,17 +138,17 @@ void sumCellsOf(const Positions& positions, std::uint32_t count, int fineLevel,
         if (!currentBox.contains(p)) {
             scratch.cellKeys.push_back(currentCode);
             scratch.cellFirst.push_back(currentFirst);
-            scratch.cellMoments.push_back(current);
-            current = {};
+            scratch.cellMoments.push_back(current.moments());
+            current.start(p);
             currentBox = UnitCellBox::of(p, fineLevel);
             currentCode = cellCode(p);
             currentFirst = i;
         }
-        current.add(p.x - origin.x, p.y - origin.y, p.z - origin.z);
+        current.add(p);
     }
     scratch.cellKeys.push_back(currentCode);
     scratch.cellFirst.push_back(currentFirst);
-    scratch.cellMoments.push_back(current);
+    scratch.cellMoments.push_back(current.moments());
     scratch.cellFirst.push_back(count);
 }
 
