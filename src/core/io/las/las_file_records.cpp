@@ -1,7 +1,8 @@
 #include "io/las/las_file_records.hpp"
 
+#include "io/record_block_reader.hpp"
+
 #include <algorithm>
-#include <tbb/task_group.h>
 
 namespace omicron {
 
@@ -14,51 +15,16 @@ LasFileRecords::LasFileRecords(std::unique_ptr<FileStream> stream, const las::He
     : m_stream(std::move(stream)), m_header(header) {}
 
 void LasFileRecords::forEachBlock(const BlockVisitor& visit) {
-    const std::uint64_t stride = m_header.recordLength;
-    const std::uint64_t recordsPerBlock = std::max<std::uint64_t>(1, kBlockBytes / stride);
-    for (std::vector<std::uint8_t>& block : m_blocks) {
-        block.resize(static_cast<std::size_t>(recordsPerBlock * stride));
-    }
-    m_stream->seek(m_header.pointDataOffset);
-    const auto readBlock = [&](std::uint64_t first) {
-        const std::uint64_t count = std::min(recordsPerBlock, m_header.pointCount - first);
-        std::vector<std::uint8_t>& block = m_blocks[(first / recordsPerBlock) % 2];
-        m_stream->readExact(block.data(), static_cast<std::size_t>(count * stride),
-                            "point records " + std::to_string(first) + " to " +
-                                std::to_string(first + count - 1) + " (counting from 0, " +
-                                std::to_string(stride) + " bytes each)");
-    };
-    // Block k + 1 is read (a copy out of the page cache, as long as parsing block k) while
-    // block k is visited, by a worker thread where one is free.
-    tbb::task_group readAhead;
-    const auto finishReadAhead = [&readAhead] {
-        try {
-            readAhead.wait();
-        } catch (...) { // the visit's error, which came first, is the one reported
-        }
-    };
-    if (m_header.pointCount > 0) {
-        readBlock(0);
-    }
-    for (std::uint64_t first = 0; first < m_header.pointCount; first += recordsPerBlock) {
-        const std::uint64_t count = std::min(recordsPerBlock, m_header.pointCount - first);
-        const std::uint64_t next = first + recordsPerBlock;
-        if (next < m_header.pointCount) {
-            readAhead.run([&readBlock, next] { readBlock(next); });
-        }
-        bool more;
-        try {
-            more = visit({m_blocks[(first / recordsPerBlock) % 2].data(), count, first,
-                          m_header.recordOffset(first + count)});
-        } catch (...) {
-            finishReadAhead();
-            throw;
-        }
-        if (!more) {
-            finishReadAhead();
+    // Block k + 1 is read (a copy out of the page cache, about as long as parsing block k) on
+    // the block reader's thread while block k is visited.
+    RecordBlockReader blocks(*m_stream, m_header.pointDataOffset, m_header.recordLength,
+                             m_header.pointCount, kBlockBytes, 0);
+    RecordBlockReader::Block block;
+    while (blocks.next(block)) {
+        if (!visit({block.records, block.count, block.firstIndex,
+                    m_header.recordOffset(block.firstIndex + block.count)})) {
             return;
         }
-        readAhead.wait(); // rethrows the next block's read error
     }
 }
 

@@ -5,7 +5,6 @@
 #include "io/las/las_header.hpp"
 #include "io/las/las_record_source.hpp"
 
-#include <array>
 #include <memory>
 #include <vector>
 
@@ -26,7 +25,6 @@ public:
 private:
     std::unique_ptr<FileStream> m_stream;
     las::Header m_header;
-    std::array<std::vector<std::uint8_t>, 2> m_blocks; // one visited, one read ahead
 };
 
 } // namespace omicron
