@@ -31,23 +31,33 @@ PointBatch batchNumber(std::size_t k, std::size_t& nextPoint) {
     return batch;
 }
 
+// What the worker received: each point's x and intensity, and how many codes were not the
+// codes of the points they came with.
+struct ConsumedPoints {
+    std::vector<float> xs;
+    std::vector<std::uint16_t> intensities;
+    std::size_t wrongCodes = 0;
+
+    void record(const PointBatch& batch, std::span<const morton::Code> codes) {
+        ASSERT_EQ(codes.size(), batch.size());
+        for (std::size_t i = 0; i < batch.size(); ++i) {
+            const glm::vec3& p = batch.positions[i];
+            xs.push_back(p.x);
+            intensities.push_back(batch.intensities[i]);
+            wrongCodes += codes[i] != morton::encodeUnit(p.x, p.y, p.z) ? 1 : 0;
+        }
+    }
+};
+
 TEST(OverlappedBatchConsumer, ConsumesEveryBatchOnceInOrderWithItsContent) {
     for (const auto delay : {std::chrono::microseconds(0), std::chrono::microseconds(200)}) {
-        std::vector<float> xs;
-        std::vector<std::uint16_t> batchOfPoint;
+        ConsumedPoints consumed;
         const std::thread::id reader = std::this_thread::get_id();
         bool otherThread = true;
-        std::size_t wrongCodes = 0;
         OverlappedBatchConsumer consumer([&](const PointBatch& batch,
                                              std::span<const morton::Code> codes) {
             otherThread = otherThread && std::this_thread::get_id() != reader;
-            ASSERT_EQ(codes.size(), batch.size());
-            for (std::size_t i = 0; i < batch.size(); ++i) {
-                const glm::vec3& p = batch.positions[i];
-                xs.push_back(p.x);
-                batchOfPoint.push_back(batch.intensities[i]);
-                wrongCodes += codes[i] != morton::encodeUnit(p.x, p.y, p.z) ? 1 : 0;
-            }
+            consumed.record(batch, codes);
             std::this_thread::sleep_for(delay); // a consumer slower than the reader
         });
         std::size_t nextPoint = 0;
@@ -60,12 +70,12 @@ TEST(OverlappedBatchConsumer, ConsumesEveryBatchOnceInOrderWithItsContent) {
         }
         consumer.finish();
         EXPECT_TRUE(otherThread);
-        ASSERT_EQ(xs.size(), nextPoint);
-        for (std::size_t i = 0; i < xs.size(); ++i) {
-            ASSERT_EQ(xs[i], static_cast<float>(i) / 4096.0f) << "point " << i;
+        ASSERT_EQ(consumed.xs.size(), nextPoint);
+        for (std::size_t i = 0; i < consumed.xs.size(); ++i) {
+            ASSERT_EQ(consumed.xs[i], static_cast<float>(i) / 4096.0f) << "point " << i;
         }
-        EXPECT_EQ(batchOfPoint, expectedBatches);
-        EXPECT_EQ(wrongCodes, 0u);
+        EXPECT_EQ(consumed.intensities, expectedBatches);
+        EXPECT_EQ(consumed.wrongCodes, 0u);
     }
 }
 
@@ -73,18 +83,10 @@ TEST(OverlappedBatchConsumer, ConsumesEveryBatchOnceInOrderWithItsContent) {
 // taken by swapping buffers (the reader's batch comes back as another buffer of the same
 // sizes), and the worker still sees every point once, in order.
 TEST(OverlappedBatchConsumer, BatchesOfOneShapeAreTakenWithoutACopy) {
-    std::vector<float> xs;
-    std::vector<std::uint16_t> batchOfPoint;
-    std::size_t wrongCodes = 0;
+    ConsumedPoints consumed;
     OverlappedBatchConsumer consumer(
         [&](const PointBatch& batch, std::span<const morton::Code> codes) {
-            ASSERT_EQ(codes.size(), batch.size());
-            for (std::size_t i = 0; i < batch.size(); ++i) {
-                const glm::vec3& p = batch.positions[i];
-                xs.push_back(p.x);
-                batchOfPoint.push_back(batch.intensities[i]);
-                wrongCodes += codes[i] != morton::encodeUnit(p.x, p.y, p.z) ? 1 : 0;
-            }
+            consumed.record(batch, codes);
         });
     constexpr std::size_t kPoints = 64;
     PointBatch batch;
@@ -107,11 +109,11 @@ TEST(OverlappedBatchConsumer, BatchesOfOneShapeAreTakenWithoutACopy) {
     }
     consumer.finish();
     EXPECT_GE(swapped, 98u) << "every batch after the first two is taken, not copied";
-    EXPECT_EQ(wrongCodes, 0u) << "codes of the points the worker got";
-    ASSERT_EQ(xs.size(), 100 * kPoints);
-    for (std::size_t i = 0; i < xs.size(); ++i) {
-        ASSERT_EQ(xs[i], static_cast<float>(i) / 8192.0f) << "point " << i;
-        ASSERT_EQ(batchOfPoint[i], i / kPoints) << "point " << i;
+    EXPECT_EQ(consumed.wrongCodes, 0u) << "codes of the points the worker got";
+    ASSERT_EQ(consumed.xs.size(), 100 * kPoints);
+    for (std::size_t i = 0; i < consumed.xs.size(); ++i) {
+        ASSERT_EQ(consumed.xs[i], static_cast<float>(i) / 8192.0f) << "point " << i;
+        ASSERT_EQ(consumed.intensities[i], i / kPoints) << "point " << i;
     }
 }
 
