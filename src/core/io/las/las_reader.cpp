@@ -30,8 +30,8 @@ namespace {
 
 // How many records, spread evenly over the file, decide the colour depth.
 constexpr std::uint64_t kColorSampleRecords = 4096;
-// Records a parse slice holds at least: a few hundred microseconds of work, so a slice costs
-// far more than handing it to another thread.
+// Records a parse slice holds at least: some 60 microseconds of work (about 8 ns a record
+// here), far more than handing a slice to another thread costs.
 constexpr std::size_t kParseSlicePoints = 8192;
 
 // LAS stores colour in 16-bit fields, but many writers put 8-bit values there unscaled.
