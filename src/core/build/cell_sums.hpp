@@ -47,7 +47,7 @@ public:
         // (x, y, z) times (y, z, x): xy, yz, zx.
         m_cross = _mm_add_ps(m_cross, _mm_mul_ps(r, _mm_shuffle_ps(r, r, _MM_SHUFFLE(3, 0, 2, 1))));
 #else
-        const glm::vec3 r = p - m_first;
+        const glm::vec3 r = p - m_firstPoint;
         m_sum += r;
         m_squares += r * r;
         m_cross += r * glm::vec3(r.y, r.z, r.x);
@@ -69,7 +69,6 @@ private:
         m_first = _mm_setr_ps(first.x, first.y, first.z, 0.0f);
         m_sum = m_squares = m_cross = _mm_setzero_ps();
 #else
-        m_first = first;
         m_sum = m_squares = m_cross = glm::vec3(0.0f);
 #endif
     }
@@ -112,12 +111,12 @@ private:
     std::uint32_t m_count = 0;      // points of the open run
     glm::vec3 m_firstPoint{0.0f};
 #if defined(__SSE2__)
-    __m128 m_first = _mm_setzero_ps();
+    __m128 m_first = _mm_setzero_ps(); // m_firstPoint in lanes, for add()
     __m128 m_sum = _mm_setzero_ps();
     __m128 m_squares = _mm_setzero_ps();
     __m128 m_cross = _mm_setzero_ps();
 #else
-    glm::vec3 m_first{0.0f}, m_sum{0.0f}, m_squares{0.0f}, m_cross{0.0f};
+    glm::vec3 m_sum{0.0f}, m_squares{0.0f}, m_cross{0.0f};
 #endif
 };
 

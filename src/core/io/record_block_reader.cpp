@@ -26,11 +26,9 @@ RecordBlockReader::RecordBlockReader(FileStream& stream, std::uint64_t start,
 }
 
 RecordBlockReader::~RecordBlockReader() {
-    if (m_reading) {
-        try {
-            m_read.wait();
-        } catch (...) { // the caller stopped early or is unwinding from its own error
-        }
+    try {
+        m_read.wait(); // the read in flight, if any
+    } catch (...) { // the caller stopped early or is unwinding from its own error
     }
 }
 
@@ -41,7 +39,6 @@ void RecordBlockReader::startRead(Slot& slot, std::uint64_t firstIndex) {
     slot.firstIndex = firstIndex;
     slot.count = 0;
     slot.shortRead = false;
-    m_reading = true;
     // The slot and the stream are the task's until wait(): the caller parses the other slot.
     m_read.run([this, &slot, bytes] {
         const std::size_t got = m_stream.read(slot.bytes.data(), bytes);
@@ -55,7 +52,6 @@ bool RecordBlockReader::next(Block& block) {
         return false;
     }
     Slot& slot = m_slots[m_nextSlot];
-    m_reading = false;
     try {
         m_read.wait(); // rethrows the read's error
     } catch (...) {

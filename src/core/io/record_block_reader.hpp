@@ -55,7 +55,6 @@ private:
     std::size_t m_recordsPerBlock;
     std::array<Slot, 2> m_slots; // one the caller parses, one being read
     std::size_t m_nextSlot = 0;  // the slot the next block is read into
-    bool m_reading = false;      // a read is in flight (into m_slots[m_nextSlot])
     bool m_ended = false;        // the last block was handed out, or the file ended early
     tbb::task_group m_read;
 };

@@ -15,8 +15,8 @@ LasFileRecords::LasFileRecords(std::unique_ptr<FileStream> stream, const las::He
     : m_stream(std::move(stream)), m_header(header) {}
 
 void LasFileRecords::forEachBlock(const BlockVisitor& visit) {
-    // Block k + 1 is read (a copy out of the page cache, about as long as parsing block k) on
-    // the block reader's thread while block k is visited.
+    // Block k + 1 is read (a copy out of the page cache, about as long as parsing block k)
+    // while block k is visited.
     RecordBlockReader blocks(*m_stream, m_header.pointDataOffset, m_header.recordLength,
                              m_header.pointCount, kBlockBytes, 0);
     RecordBlockReader::Block block;

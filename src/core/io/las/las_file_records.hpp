@@ -6,7 +6,6 @@
 #include "io/las/las_record_source.hpp"
 
 #include <memory>
-#include <vector>
 
 namespace omicron {
 
