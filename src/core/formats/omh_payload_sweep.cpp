@@ -171,16 +171,21 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
     // order, so a batch's nodes at each level follow those of the level above: as many as
     // the batch's nodes there have children.
     std::vector<std::size_t> next(static_cast<std::size_t>(levelCount), 0);
-    // Two batches in flight: while a writer thread encodes (in parallel), hashes and writes
+    // Batches in flight: while a writer thread encodes (in parallel), hashes and writes
     // (serially; on a disk mostly waiting for it) one, the calling thread and TBB estimate the
     // splat attributes of the next (parallel, and over a scratch file mostly waiting for its
     // reads). Only the writer touches the sinks and the encoder; both stages only read the
-    // hierarchy and the cloud.
+    // hierarchy and the cloud. In memory the estimation may run a second batch ahead: the
+    // writer's serial stage (the hash and the kernel's copy) is the longer of the two, and
+    // while the calling thread waited for it the other core idled once the writer had encoded
+    // its tokens ahead (24.2 M points: an eighth of the save). Over a scratch file two batches
+    // (their splats sized to the budget) are all it holds.
     struct Batch {
         std::vector<std::pair<int, std::size_t>> nodes; // (level, index), level by level
         std::vector<NodeSplats> splats;
     };
-    std::array<Batch, 2> batches;
+    const std::size_t slots = cloud.fileBacked() ? 2 : 3;
+    std::array<Batch, 3> batches;
     ParallelRecordEncoder encoder(cloud, layout, sinks, firstLevel);
     const auto write = [&](const Batch& batch) {
         for (std::size_t b = 0; b < batch.nodes.size(); ++b) {
@@ -189,7 +194,8 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
         }
         encoder.finish(); // before the batch's splats are reused
     };
-    BackgroundJob writing; // of the previous batch; its destructor waits for it
+    // The writes of the batches before (slots - 1 at most); its destructor waits for them.
+    BackgroundJob writing(slots - 1);
     tbb::enumerable_thread_specific<SplatScratch> scratch;
 
     const std::vector<std::uint64_t>& rootPoints = subtrees[static_cast<std::size_t>(firstLevel)];
@@ -219,7 +225,7 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
     if (roots > 0) {
         readAhead(0, end);
     }
-    for (std::size_t begin = 0, slot = 0; begin < roots; slot ^= 1) {
+    for (std::size_t begin = 0, slot = 0; begin < roots; slot = (slot + 1) % slots) {
         cloud.keepWithinBudget(); // what the previous batch read may go first
         // The next batch's stretch is read while this one is estimated and written (a cloud
         // in a scratch file: the disk reads ahead instead of waiting for each batch's faults).
@@ -227,7 +233,8 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
         if (end < roots) {
             readAhead(end, nextEnd);
         }
-        Batch& batch = batches[slot]; // the writer is done with it: waited for below
+        // The writer is done with this slot: start() below waited for its write.
+        Batch& batch = batches[slot];
         batch.nodes.clear();
         std::size_t count = end - begin;
         for (int level = firstLevel; level < levelCount && count > 0; ++level) {
@@ -251,7 +258,8 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
         if (afterRead) { // the batch's pages are in memory: the estimation read them
             afterRead(coveredEnd(hierarchy.node(firstLevel, end - 1)));
         }
-        // The previous batch is written (or its error is thrown here) before this one starts.
+        // Waits until at most slots - 2 earlier batches are still being written (or throws
+        // the error of one), so the slot estimated next is free.
         writing.start([&write, &batch] { write(batch); });
         begin = end;
         end = nextEnd;
