@@ -5,8 +5,9 @@
 // viewer can draw its first overview.
 //
 // usage: io_bench FILE [--depth D]   (e.g. ../shared/data/autzen_south.ply, depth 7)
-// The files go to a fresh temporary folder, removed at the end. Every time
+// The files go to a fresh temporary folder, removed at the end (bench_scratch.hpp). Every time
 // is the best of 3 runs from files the page cache holds (what a second session sees).
+#include "bench_scratch.hpp"
 #include "bench_timing.hpp"
 #include "build/hierarchy_builder.hpp"
 #include "formats/omh_reader.hpp"
@@ -21,7 +22,6 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
-#include <unistd.h>
 
 namespace {
 
@@ -54,7 +54,8 @@ int main(int argc, char** argv) {
         depth = std::atoi(argv[3]);
     }
     namespace fs = std::filesystem;
-    const fs::path folder = fs::temp_directory_path() / ("io_bench-" + std::to_string(::getpid()));
+    const omicron::bench::ScratchPath scratch("io_bench-");
+    const fs::path& folder = scratch.path();
     try {
         fs::create_directories(folder);
         const std::string omsPath = (folder / "cloud.oms").string();
@@ -133,9 +134,7 @@ int main(int argc, char** argv) {
                     firstLevelSeconds * 1e3, saveSeconds * 1e3, verifySeconds * 1e3);
     } catch (const std::exception& error) {
         std::fprintf(stderr, "io_bench: %s\n", error.what());
-        fs::remove_all(folder);
         return 1;
     }
-    fs::remove_all(folder);
     return 0;
 }

@@ -16,19 +16,20 @@
 //   rss_after_overview_mb, rss_end_mb (/proc/self/statm) and peak_rss_mb (getrusage).
 // Run it once per configuration: the peak RSS is the process's. bench/out_of_core.sh makes a
 // large .omh from a real scan and runs every configuration.
+#include "bench_scratch.hpp"
 #include "bench_timing.hpp"
 #include "formats/omh_reader.hpp"
 #include "formats/omh_writer.hpp"
-#include "pipeline/build_pipeline.hpp"
 #include "front/front.hpp"
 #include "front/front_settle.hpp"
 #include "memory_budget.hpp"
+#include "pipeline/build_pipeline.hpp"
 
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <fcntl.h>
+#include <filesystem>
 #include <string>
 #include <sys/resource.h>
 #include <thread>
@@ -111,24 +112,14 @@ int main(int argc, char** argv) {
     }
     std::string path = argv[1];
     // Any cloud: built and saved first, as `omicron-cli build --save` would.
-    struct Scratch {
-        std::string file;
-        ~Scratch() {
-            if (!file.empty()) {
-                std::filesystem::remove(file);
-            }
-        }
-    } scratch;
+    const omicron::bench::ScratchPath scratch("omh_paging_bench_", ".omh");
     try {
         if (!isOmhFile(path)) {
             BuildPipeline pipeline;
             pipeline.run(path, PipelineOptions{});
-            scratch.file = (std::filesystem::temp_directory_path() /
-                            ("omh_paging_bench_" + std::to_string(getpid()) + ".omh"))
-                               .string();
-            writeOmh(scratch.file, *pipeline.hierarchy(),
+            writeOmh(scratch.path().string(), *pipeline.hierarchy(),
                      omhBuildInfo(pipeline.hierarchyOptions(), pipeline.statistics()));
-            path = scratch.file;
+            path = scratch.path().string();
         }
         const double rawMs = rawReadMs(path);
         const auto start = Clock::now();

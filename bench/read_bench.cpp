@@ -2,8 +2,7 @@
 // with the page cache warm, so the ratio shows parsing cost rather than disk speed.
 //
 // usage: read_bench FILE [--keep-temp]   (--keep-temp: the converted files stay, in a folder it
-//                                          names; a run that was killed leaves its folder, which
-//                                          the next run removes)
+//                                          names; see bench_scratch.hpp)
 //        read_bench --laz FILE.laz [SAME_POINTS.las] [--laz-perf NODE_MODULES_DIR]
 // FILE is read as it is; then the same points are written as binary big-endian PLY, ascii PLY,
 // LAS 1.4 (point format 7) and XYZ text in a temporary folder and each is measured too.
@@ -21,6 +20,7 @@
 // The same points sorted into a .oms (pipeline 2's input) are measured too, reader=oms
 // phase=parse: OmsReader streaming the records into its cloud, each range's codes recomputed
 // and checked for order, and the payload checksum (a FILE that is a .oms is measured alone).
+#include "bench_scratch.hpp"
 #include "bench_timing.hpp"
 #include "formats/oms_reader.hpp"
 #include "formats/oms_writer.hpp"
@@ -32,9 +32,7 @@
 #include "io/point_reader.hpp"
 #include "io/xyz/xyz_writer.hpp"
 
-#include <cerrno>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
@@ -243,50 +241,6 @@ int measureLaz(const std::string& laz, const std::string& las, const std::string
     return 0;
 }
 
-// The scratch folders of earlier runs that were killed (Ctrl+C, a timeout) before they could
-// remove theirs: each holds the input converted to four formats, gigabytes for a large cloud.
-// A folder is stale when the process its name ends with is gone.
-constexpr const char* kScratchPrefix = "omicron-read-bench-";
-
-void removeStaleScratchFolders(const std::filesystem::path& parent) try {
-    std::error_code error;
-    for (const auto& entry : std::filesystem::directory_iterator(parent, error)) {
-        const std::string name = entry.path().filename().string();
-        if (!entry.is_directory(error) || !name.starts_with(kScratchPrefix)) {
-            continue;
-        }
-        const std::string digits = name.substr(std::strlen(kScratchPrefix));
-        if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos) {
-            continue;
-        }
-        const auto pid = static_cast<pid_t>(std::stol(digits));
-        if (::kill(pid, 0) != 0 && errno == ESRCH) {
-            std::filesystem::remove_all(entry.path(), error);
-        }
-    }
-} catch (const std::filesystem::filesystem_error&) {
-    // Best effort: a folder it cannot list or remove stays, and the run goes on.
-}
-
-// The run's scratch folder: removed when the run ends, also by an error; with --keep-temp
-// renamed instead to a name the stale-folder sweep above leaves alone.
-struct ScratchFolder {
-    std::filesystem::path path;
-    bool keep = false;
-    ~ScratchFolder() {
-        std::error_code error;
-        if (!keep) {
-            std::filesystem::remove_all(path, error);
-            return;
-        }
-        const auto kept =
-            path.parent_path() / ("omicron-read-bench-kept-" + std::to_string(::getpid()));
-        std::filesystem::rename(path, kept, error);
-        std::fprintf(stderr, "read_bench: the converted files are in %s\n",
-                     (error ? path : kept).c_str());
-    }
-};
-
 } // namespace
 
 int main(int argc, char** argv) {
@@ -331,11 +285,12 @@ int main(int argc, char** argv) {
         measure(label(omicron::detectFormat(input)), input, 3);
 
         const omicron::LoadedCloud cloud = omicron::loadPointCloud(input);
-        removeStaleScratchFolders(std::filesystem::temp_directory_path());
-        const auto folder =
-            std::filesystem::temp_directory_path() / (kScratchPrefix + std::to_string(::getpid()));
+        omicron::bench::ScratchPath scratch("omicron-read-bench-");
+        if (keepTemp) {
+            scratch.keep();
+        }
+        const std::filesystem::path& folder = scratch.path();
         std::filesystem::create_directories(folder);
-        const ScratchFolder scratch{folder, keepTemp};
         const auto file = [&](const char* name) {
             return (folder / name).string();
         };
