@@ -9,6 +9,7 @@
 #include <csignal>
 #include <filesystem>
 #include <gtest/gtest.h>
+#include <memory>
 #include <thread>
 
 namespace omicron {
@@ -163,6 +164,48 @@ TEST(CliExportPotree, InterruptedExportLeavesNothingHalfWritten) {
                 << entry.path();
         }
     }
+}
+
+// An export killed outright (SIGKILL: no handler, no destructor) leaves its temporary folder.
+// The next export to the same target removes it once its maker is gone, and never one whose
+// maker still runs.
+TEST(CliExportPotree, AKilledExportsFolderIsRemovedByTheNextExport) {
+    OMICRON_REQUIRE_SHARED_FILE(input, "bunny.ply");
+    test::TempDir dir;
+    const std::string folder = dir.file("potree");
+    const auto temporaries = [&] {
+        std::size_t count = 0;
+        for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+            count += entry.path().filename().string().starts_with(".potree.tmp-") ? 1 : 0;
+        }
+        return count;
+    };
+    const auto startPaused = [&](const std::string& errName) {
+        auto child = std::make_unique<test::RunningProcess>(
+            OMICRON_CLI_PATH, std::vector<std::string>{"export-potree", input, folder},
+            std::vector<std::string>{"OMICRON_TEST_PAUSE_POTREE_EXPORT=1"}, dir.file(errName));
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+        std::string err;
+        while (err.find("paused") == std::string::npos &&
+               std::chrono::steady_clock::now() < deadline) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            const auto bytes = test::readBytes(dir.file(errName));
+            err.assign(bytes.begin(), bytes.end());
+        }
+        EXPECT_NE(err.find("paused"), std::string::npos) << err;
+        return child;
+    };
+    auto paused = startPaused("paused.txt");
+    ASSERT_EQ(temporaries(), 1u);
+    // Another export meanwhile: the paused one still runs, so its folder stays.
+    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"export-potree", input, folder}).exitCode, 0);
+    EXPECT_EQ(temporaries(), 1u) << "an export removed the folder of one still running";
+    paused->kill();
+    EXPECT_EQ(temporaries(), 1u) << "SIGKILL runs no clean-up";
+    const auto next = runProcess(OMICRON_CLI_PATH, {"export-potree", input, folder});
+    ASSERT_EQ(next.exitCode, 0) << next.err;
+    EXPECT_EQ(temporaries(), 0u) << "the killed export's folder outlived the next export";
+    EXPECT_EQ(metadataPoints(folder), 35947u);
 }
 
 } // namespace

@@ -8,6 +8,7 @@
 #include <csignal>
 #include <filesystem>
 #include <gtest/gtest.h>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -123,36 +124,50 @@ INSTANTIATE_TEST_SUITE_P(
                     "render: bad size for --memory-budget: 'lots'"}),
     [](const auto& info) { return std::string(info.param.name); });
 
+// A sort of autzen_south under the smallest budget into `scratch`, returned once it has a
+// scratch file open there (a run being written).
+std::unique_ptr<test::RunningProcess>
+startSpillingSort(const std::string& input, const TempDir& dir, const TempDir& scratch) {
+    std::filesystem::create_directory(dir.path() / "out");
+    auto child = std::make_unique<test::RunningProcess>(
+        OMICRON_CLI_PATH,
+        std::vector<std::string>{"sort", input, (dir.path() / "out" / "south.oms").string(),
+                                 "--memory-budget", "4M", "--temp-dir", scratch.path().string()},
+        std::vector<std::string>{}, dir.file("stderr.txt"));
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (test::openFilesIn(child->pid(), scratch.path()).size() == 0 &&
+           std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    EXPECT_GT(test::openFilesIn(child->pid(), scratch.path()).size(), 0u)
+        << "no sorted run appeared";
+    return child;
+}
+
 // Ctrl+C while the sort spills: exit 130, and neither the runs nor the output remain.
 TEST(CliMemoryBudget, InterruptRemovesTheRunsAndTheOutput) {
     OMICRON_REQUIRE_SHARED_FILE(south, "autzen_south.ply");
     TempDir dir;
     TempDir scratch;
-    std::filesystem::create_directory(dir.path() / "out");
-    test::RunningProcess child(OMICRON_CLI_PATH,
-                               {"sort", south, (dir.path() / "out" / "south.oms").string(),
-                                "--memory-budget", "4M", "--temp-dir", scratch.path().string()},
-                               {}, dir.file("stderr.txt"));
-    // The scratch folder holds the sort's own folder as soon as the sort starts; wait for
-    // a run in it.
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    const auto runWritten = [&] {
-        for (const auto& folder : std::filesystem::directory_iterator(scratch.path())) {
-            if (!std::filesystem::is_empty(folder.path())) {
-                return true;
-            }
-        }
-        return false;
-    };
-    while (!runWritten() && std::chrono::steady_clock::now() < deadline) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    }
-    ASSERT_TRUE(runWritten()) << "no sorted run appeared";
-    child.signal(SIGINT);
-    const std::optional<int> status = child.waitFor(std::chrono::seconds(60));
+    const auto child = startSpillingSort(south, dir, scratch);
+    child->signal(SIGINT);
+    const std::optional<int> status = child->waitFor(std::chrono::seconds(60));
     ASSERT_TRUE(status.has_value()) << "sort did not stop after SIGINT";
     const std::vector<std::uint8_t> err = test::readBytes(dir.file("stderr.txt"));
     EXPECT_EQ(*status, 130) << std::string(err.begin(), err.end());
+    EXPECT_TRUE(std::filesystem::is_empty(scratch.path()));
+    EXPECT_TRUE(std::filesystem::is_empty(dir.path() / "out"));
+}
+
+// Killed outright (SIGKILL, or the out-of-memory killer) while the sort spills, the process
+// cleans up nothing, and still nothing remains: its scratch files and its output's temporary
+// have no names.
+TEST(CliMemoryBudget, AKilledSortLeavesNoScratchFiles) {
+    OMICRON_REQUIRE_SHARED_FILE(south, "autzen_south.ply");
+    TempDir dir;
+    TempDir scratch;
+    const auto child = startSpillingSort(south, dir, scratch);
+    child->kill();
     EXPECT_TRUE(std::filesystem::is_empty(scratch.path()));
     EXPECT_TRUE(std::filesystem::is_empty(dir.path() / "out"));
 }

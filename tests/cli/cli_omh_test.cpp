@@ -4,6 +4,7 @@
 #include "std_regex.hpp"
 #include "test_files.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -99,14 +100,21 @@ TEST(CliOmh, ASaveKilledHalfWayLeavesThePreviousFileIntact) {
         ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "the save never paused";
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
-    // The paused save has its temporary file beside the target.
-    bool temporary = false;
-    for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
-        temporary |= entry.path().filename().string().starts_with(".a.omh.tmp-");
-    }
-    EXPECT_TRUE(temporary);
+    // The paused save has its temporary file open beside the target (with its stderr), and
+    // the temporary has no name: killed, the process leaves nothing behind.
+    const auto namesInDir = [&] {
+        std::vector<std::string> names;
+        for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+            names.push_back(entry.path().filename().string());
+        }
+        std::sort(names.begin(), names.end());
+        return names;
+    };
+    EXPECT_EQ(test::openFilesIn(child.pid(), dir.path()).size(), 2u);
+    EXPECT_EQ(namesInDir(), (std::vector<std::string>{"a.omh", "stderr"}));
     child.kill();
 
+    EXPECT_EQ(namesInDir(), (std::vector<std::string>{"a.omh", "stderr"}));
     EXPECT_EQ(test::readBytes(saved), before);
     const auto info = runProcess(OMICRON_CLI_PATH, {"info", saved, "--verify", "--json"});
     EXPECT_EQ(info.exitCode, 0) << info.err;

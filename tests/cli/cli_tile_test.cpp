@@ -172,12 +172,14 @@ TEST(CliTile, InterruptLeavesNoOutputNorTemporary) {
     std::filesystem::create_directory(dir.path() / "out");
     test::RunningProcess child(OMICRON_CLI_PATH, {"tile", south, out, "--copies", "40"}, {},
                                dir.file("stderr.txt"));
+    // The temporary has no name until it is complete: it shows as the child's open file.
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    while (std::filesystem::is_empty(dir.path() / "out") &&
+    while (test::openFilesIn(child.pid(), dir.path() / "out").empty() &&
            std::chrono::steady_clock::now() < deadline) {
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
-    ASSERT_FALSE(std::filesystem::is_empty(dir.path() / "out")) << "no temporary file appeared";
+    ASSERT_FALSE(test::openFilesIn(child.pid(), dir.path() / "out").empty())
+        << "no temporary file appeared";
     child.signal(SIGINT);
     const std::optional<int> status = child.waitFor(std::chrono::seconds(60));
     ASSERT_TRUE(status.has_value()) << "tile did not stop after SIGINT";

@@ -136,4 +136,19 @@ std::optional<int> RunningProcess::waitFor(std::chrono::milliseconds timeout) {
     }
 }
 
+std::vector<std::filesystem::path> openFilesIn(int pid, const std::filesystem::path& folder) {
+    const std::filesystem::path fds =
+        pid == 0 ? std::string("/proc/self/fd") : "/proc/" + std::to_string(pid) + "/fd";
+    const std::string prefix = std::filesystem::canonical(folder).string() + "/";
+    std::vector<std::filesystem::path> open;
+    std::error_code error; // the process may end, and its descriptors close, while we look
+    for (const auto& entry : std::filesystem::directory_iterator(fds, error)) {
+        const std::filesystem::path target = std::filesystem::read_symlink(entry.path(), error);
+        if (!error && target.string().starts_with(prefix)) {
+            open.push_back(entry.path());
+        }
+    }
+    return open;
+}
+
 } // namespace omicron::test

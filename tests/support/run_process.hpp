@@ -2,6 +2,7 @@
 #pragma once
 
 #include <chrono>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -36,9 +37,16 @@ public:
     // Waits up to `timeout` for the child to end: its exit code (-1 when a signal ended it),
     // or nothing while it still runs.
     std::optional<int> waitFor(std::chrono::milliseconds timeout);
+    // The child's process ID, -1 once it has ended and been reaped.
+    int pid() const { return m_pid; }
 
 private:
     int m_pid = -1;
 };
+
+// The files process `pid` (0: this process) has open in `folder`, named or not, as their
+// descriptors' /proc links ("/proc/PID/fd/N": stat() and open() through one reach the file;
+// a nameless file's link still names its folder: "/FOLDER/#INODE (deleted)").
+std::vector<std::filesystem::path> openFilesIn(int pid, const std::filesystem::path& folder);
 
 } // namespace omicron::test

@@ -1,5 +1,8 @@
 #include "io/atomic_file_writer.hpp"
 
+#include "nameless_file.hpp"
+
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -42,15 +45,24 @@ AtomicFileWriter::AtomicFileWriter(std::string targetPath)
         target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
     std::string tempName = target.filename().string();
     tempName.insert(0, 1, '.');
-    tempName.append(".tmp-XXXXXX");
-    std::string pattern = (folder / tempName).string();
-    m_fd = ::mkstemp(pattern.data());
-    if (m_fd < 0) {
-        throw OutputError(m_targetPath + ": cannot create a temporary file in " +
-                          folder.string() + ": " + std::strerror(errno));
+    tempName.append(".tmp-");
+    m_tempPrefix = (folder / tempName).string();
+    m_fd = openNamelessFile(folder.string(), 0600);
+    if (m_fd >= 0 && !canNameFiles(m_fd)) {
+        ::close(m_fd); // it could never be renamed onto the target
+        m_fd = -1;
     }
-    m_tempPath = pattern;
-    // mkstemp creates 0600; a replaced file keeps its mode, a new one gets the usual 0644.
+    m_nameless = m_fd >= 0;
+    if (!m_nameless) {
+        std::string pattern = m_tempPrefix + "XXXXXX";
+        m_fd = ::mkostemp(pattern.data(), O_CLOEXEC);
+        if (m_fd < 0) {
+            throw OutputError(m_targetPath + ": cannot create a temporary file in " +
+                              folder.string() + ": " + std::strerror(errno));
+        }
+        m_tempPath = pattern;
+    }
+    // Made 0600 either way; a replaced file keeps its mode, a new one gets the usual 0644.
     struct stat existing {};
     const mode_t mode = ::stat(m_targetPath.c_str(), &existing) == 0 ? (existing.st_mode & 07777)
                                                                       : mode_t{0644};
@@ -190,10 +202,31 @@ void AtomicFileWriter::dropFromCache(std::uint64_t offset, std::uint64_t count) 
                   POSIX_FADV_DONTNEED);
 }
 
+void AtomicFileWriter::nameTemporary() {
+    // Unique among this process's saves by the counter and among processes by the PID; a
+    // name left by a process killed in the instant between this and the rename is skipped.
+    static std::atomic<unsigned> counter{0};
+    for (int attempt = 0; attempt < 1000; ++attempt) {
+        const std::string name =
+            m_tempPrefix + std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1));
+        if (nameFile(m_fd, name)) {
+            m_tempPath = name;
+            return;
+        }
+        if (errno != EEXIST) {
+            fail("cannot give the finished temporary file a name in its folder", errno);
+        }
+    }
+    fail("cannot give the finished temporary file a name in its folder", EEXIST);
+}
+
 void AtomicFileWriter::commit() {
     flushBuffer();
     if (::fsync(m_fd) != 0) {
         fail("fsync failed", errno);
+    }
+    if (m_nameless) {
+        nameTemporary();
     }
     if (::close(m_fd) != 0) {
         m_fd = -1;

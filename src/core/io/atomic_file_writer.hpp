@@ -1,6 +1,9 @@
 // Writes a file so that the target is either the complete new file or untouched: bytes go to
 // a temporary file in the target's folder, commit() flushes, fsyncs and renames it over the
-// target. Destroyed without commit() (an error, an exception), the temporary is removed.
+// target. Destroyed without commit() (an error, an exception), the temporary is removed. The
+// temporary has no name until commit() (nameless_file.hpp), so a process killed while it
+// writes leaves nothing behind; where the file system cannot make nameless files it is
+// ".NAME.tmp-XXXXXX" from the start.
 #pragma once
 
 #include <cstddef>
@@ -57,9 +60,13 @@ private:
     // Large files: written windows leave the page cache (see the .cpp).
     void dropBehind();
     [[noreturn]] void fail(const std::string& what, int error);
+    // Gives the nameless temporary its hidden name beside the target, for the rename.
+    void nameTemporary();
 
     std::string m_targetPath;
-    std::string m_tempPath;
+    std::string m_tempPath; // empty while the temporary has no name
+    std::string m_tempPrefix;
+    bool m_nameless = false;
     int m_fd = -1;
     std::vector<char> m_buffer;
     std::size_t m_buffered = 0;

@@ -8,8 +8,11 @@
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
+#include <fstream>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <vector>
 
 namespace omicron {
 
@@ -33,6 +36,51 @@ fs::path normalised(const std::string& path) {
         target = target.parent_path();
     }
     return target;
+}
+
+// This boot of this machine and this PID namespace, so that a PID in a temporary folder's name
+// means a process here only where the name carries the same token; "" where /proc cannot tell.
+std::string makerToken() {
+    std::ifstream bootFile("/proc/sys/kernel/random/boot_id");
+    std::string boot;
+    std::getline(bootFile, boot);
+    std::error_code error;
+    const std::string pidNamespace = fs::read_symlink("/proc/self/ns/pid", error).string();
+    std::string namespaceNumber; // "pid:[4026531836]" -> "4026531836"
+    for (const char c : pidNamespace) {
+        if (c >= '0' && c <= '9') {
+            namespaceNumber += c;
+        }
+    }
+    if (boot.size() < 8 || error || namespaceNumber.empty()) {
+        return "";
+    }
+    return boot.substr(0, 8) + "." + namespaceNumber;
+}
+
+// Removes the temporary folders named `prefix` + "PID-XXXXXX" whose process no longer runs:
+// left by an export killed outright (SIGKILL, a crash, the out-of-memory killer), which no
+// destructor saw. A folder moved aside during a replace ("....old") is the previous export's
+// only copy if the process died between its two renames, and stays.
+void removeAbandoned(const fs::path& parent, const std::string& prefix) {
+    std::vector<fs::path> abandoned;
+    std::error_code error;
+    for (const auto& entry : fs::directory_iterator(parent, error)) {
+        const std::string name = entry.path().filename().string();
+        if (!name.starts_with(prefix)) {
+            continue;
+        }
+        const char* digits = name.c_str() + prefix.size();
+        char* end = nullptr;
+        const long pid = std::strtol(digits, &end, 10);
+        const bool wellFormed = end != digits && pid > 0 && *end == '-' && std::strlen(end) == 7;
+        if (wellFormed && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) {
+            abandoned.push_back(entry.path());
+        }
+    }
+    for (const fs::path& folder : abandoned) {
+        fs::remove_all(folder, error); // best effort: another export may be removing it too
+    }
 }
 
 void syncFolder(const fs::path& folder) {
@@ -59,9 +107,14 @@ AtomicFolder::AtomicFolder(std::string targetPath, ReplaceCheck mayReplace)
         throw OutputError(m_targetPath + ": its parent folder " + parent.string() +
                           " does not exist");
     }
-    std::string tempName(".");
-    tempName.append(target.filename().string()).append(".tmp-XXXXXX");
-    std::string pattern = (parent / tempName).string();
+    // ".NAME.tmp-TOKEN-PID-XXXXXX": the token and PID say whether its maker still runs.
+    const std::string token = makerToken();
+    std::string prefix("."); // appended, not "." + ...: GCC 12 warns wrongly on that (restrict)
+    prefix.append(target.filename().string()).append(".tmp-").append(token).append("-");
+    if (!token.empty()) {
+        removeAbandoned(parent, prefix);
+    }
+    std::string pattern = (parent / (prefix + std::to_string(::getpid()) + "-XXXXXX")).string();
     if (::mkdtemp(pattern.data()) == nullptr) {
         throw OutputError(m_targetPath + ": cannot create a temporary folder in " +
                           parent.string() + ": " + std::strerror(errno));

@@ -4,6 +4,9 @@
 // without commit() (an error, an exception, a cancelled export), the temporary folder and
 // everything in it is removed. A reader never sees a half-written folder under the target's
 // name: for a Potree export, no metadata.json that announces an octree.bin still being written.
+// A process killed outright leaves its temporary folder (its files have no names until
+// complete, see AtomicFileWriter); the next AtomicFolder for the same target removes it, once
+// the folder's name shows that its maker, a process of this machine, no longer runs.
 #pragma once
 
 #include <functional>

@@ -1,4 +1,5 @@
 // The scratch-file mappings of points/huge_page_buffer.hpp (FileBacking).
+#include "nameless_file.hpp"
 #include "points/huge_page_buffer.hpp"
 
 #include <algorithm>
@@ -22,8 +23,8 @@ namespace {
 } // namespace
 
 void* mapScratchFile(const std::string& folder, std::size_t bytes, int& fd) {
-    // An unnamed file: nothing to remove, whatever way the process ends.
-    fd = open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+    // A file without a name: nothing to remove, whatever way the process ends.
+    fd = openScratchFile(folder, "omicron-cloud-");
     if (fd < 0) {
         fail(folder, bytes, "creating the file", errno);
     }

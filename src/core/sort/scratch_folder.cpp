@@ -2,6 +2,7 @@
 
 #include "io/atomic_file_writer.hpp"
 #include "memory_budget.hpp"
+#include "nameless_file.hpp"
 #include "points/huge_page_buffer.hpp"
 
 #include <algorithm>
@@ -9,34 +10,26 @@
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
-#include <filesystem>
 #include <stdexcept>
 #include <sys/statvfs.h>
 #include <unistd.h>
-#include <vector>
 
 namespace omicron {
 
 ScratchFolder::ScratchFolder(const std::string& parent)
     : m_parent(parent.empty() ? defaultParent() : parent) {
-    std::string pattern = (std::filesystem::path(m_parent) / "omicron-runs-XXXXXX").string();
-    std::vector<char> name(pattern.begin(), pattern.end());
-    name.push_back('\0');
-    if (::mkdtemp(name.data()) == nullptr) {
-        throw OutputError(m_parent + ": cannot make a scratch folder for the sorted runs there: " +
-                          std::strerror(errno) + " (choose another with --temp-dir)");
+    // A first file, closed at once: an unusable folder is this error, before any work.
+    const int probe = openScratchFile(m_parent, "omicron-run-");
+    if (probe < 0) {
+        throw OutputError(m_parent + ": cannot make scratch files for the sorted runs there: " +
+                          std::strerror(errno) + " (choose another folder with --temp-dir)");
     }
-    m_path = name.data();
-}
-
-ScratchFolder::~ScratchFolder() {
-    std::error_code ignored; // nothing to report to from a destructor; the folder is ours alone
-    std::filesystem::remove_all(m_path, ignored);
+    ::close(probe);
 }
 
 std::uint64_t ScratchFolder::freeBytes() const {
     struct statvfs status = {};
-    if (::statvfs(m_path.c_str(), &status) != 0) {
+    if (::statvfs(m_parent.c_str(), &status) != 0) {
         return UINT64_MAX;
     }
     return static_cast<std::uint64_t>(status.f_bavail) * status.f_frsize;
@@ -48,8 +41,7 @@ std::string ScratchFolder::defaultParent() {
 }
 
 void ScratchFolder::failWrite(const std::string& file, int error) const {
-    throw OutputError(m_parent + ": cannot write the sorted run " +
-                      std::filesystem::path(file).filename().string() + ": " +
+    throw OutputError(m_parent + ": cannot write the sorted run " + file + ": " +
                       std::strerror(error) + "; the runs of this cloud need " +
                       formatByteSize(m_bytesNeeded) + " (" + std::to_string(m_bytesNeeded) +
                       " bytes), " + std::to_string(m_bytesWritten) +
@@ -58,10 +50,10 @@ void ScratchFolder::failWrite(const std::string& file, int error) const {
 }
 
 ScratchFile::ScratchFile(ScratchFolder& folder, const std::string& name)
-    : m_folder(folder), m_path((std::filesystem::path(folder.path()) / name).string()) {
-    m_fd = ::open(m_path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    : m_folder(folder), m_name(name) {
+    m_fd = openScratchFile(folder.parent(), "omicron-" + name + "-");
     if (m_fd < 0) {
-        m_folder.failWrite(m_path, errno);
+        m_folder.failWrite(m_name, errno);
     }
 }
 
@@ -79,7 +71,7 @@ void ScratchFile::write(const void* data, std::size_t count) {
             continue;
         }
         if (written <= 0) {
-            m_folder.failWrite(m_path, written < 0 ? errno : ENOSPC);
+            m_folder.failWrite(m_name, written < 0 ? errno : ENOSPC);
         }
         bytes += written;
         count -= static_cast<std::size_t>(written);
@@ -96,8 +88,8 @@ void ScratchFile::read(std::uint64_t offset, void* data, std::size_t count) cons
             continue;
         }
         if (got <= 0) {
-            throw std::runtime_error(m_path + ": cannot read back a sorted run at byte " +
-                                     std::to_string(offset) + ": " +
+            throw std::runtime_error(m_folder.parent() + ": cannot read back the sorted run " +
+                                     m_name + " at byte " + std::to_string(offset) + ": " +
                                      (got < 0 ? std::strerror(errno) : "unexpected end"));
         }
         bytes += got;

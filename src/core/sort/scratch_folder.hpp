@@ -1,7 +1,8 @@
-// Scratch space for clouds larger than memory: a private folder for the sorter's runs, made
-// (mkdtemp) under the folder the user chose (--temp-dir, the app's setting, else $TMPDIR or
-// /tmp) and removed with everything in it when destroyed: after success, an error, a cancel or
-// Ctrl+C (the CLI turns the signal into an exception), so no run outlives its pipeline.
+// Scratch space for clouds larger than memory: the sorter's runs, as files without a name
+// (nameless_file.hpp) in the folder the user chose (--temp-dir, the app's setting, else
+// $TMPDIR or /tmp). The kernel frees each when its ScratchFile closes it, or when the process
+// ends however it ends (SIGKILL, a crash, the out-of-memory killer): no run outlives its
+// pipeline, and nothing there is ours to clean up.
 #pragma once
 
 #include <cstddef>
@@ -12,13 +13,12 @@ namespace omicron {
 
 class ScratchFolder {
 public:
-    // Throws OutputError naming `parent` when the folder cannot be made there.
+    // `parent` empty: defaultParent(). Throws OutputError naming the folder when no file can
+    // be made there (no such folder, no permission).
     explicit ScratchFolder(const std::string& parent);
-    ~ScratchFolder();
     ScratchFolder(const ScratchFolder&) = delete;
     ScratchFolder& operator=(const ScratchFolder&) = delete;
 
-    const std::string& path() const { return m_path; }
     const std::string& parent() const { return m_parent; }
 
     // Bytes its file system has free for us (statvfs), UINT64_MAX when it cannot tell.
@@ -39,12 +39,12 @@ private:
     [[noreturn]] void failWrite(const std::string& file, int error) const;
 
     std::string m_parent;
-    std::string m_path;
     std::uint64_t m_bytesNeeded = 0;
     std::uint64_t m_bytesWritten = 0;
 };
 
 // One file in a ScratchFolder, written front to back, then read by offset from any thread.
+// `name` only labels it in messages: the file has none.
 class ScratchFile {
 public:
     ScratchFile(ScratchFolder& folder, const std::string& name); // throws OutputError
@@ -59,11 +59,11 @@ public:
     // that has nothing else to do).
     void willRead(std::uint64_t offset, std::uint64_t count) const;
     std::uint64_t size() const { return m_size; }
-    const std::string& path() const { return m_path; }
+    const std::string& name() const { return m_name; }
 
 private:
     ScratchFolder& m_folder;
-    std::string m_path;
+    std::string m_name;
     int m_fd = -1;
     std::uint64_t m_size = 0;
 };

@@ -6,6 +6,7 @@
 #include "formats/oms_writer.hpp"
 #include "io/input_error.hpp"
 #include "io/point_reader.hpp"
+#include "run_process.hpp"
 #include "sort/morton_sorter.hpp"
 #include "test_files.hpp"
 
@@ -793,8 +794,11 @@ TEST(OmsWriter, DestroyedWithoutFinishLeavesNoTemporaryAndKeepsTheTarget) {
         OmsWriter writer;
         writer.open(file.path, other->cube(), other->sourceOffset(), other->attributes(), 200);
         writer.append(*other, 0, 100);
-        EXPECT_EQ(fileCount(file.dir.path()), 2u) << "the temporary is beside the target";
+        EXPECT_EQ(test::openFilesIn(0, file.dir.path()).size(), 1u)
+            << "the temporary is beside the target";
+        EXPECT_EQ(fileCount(file.dir.path()), 1u) << "the temporary has a name";
     }
+    EXPECT_TRUE(test::openFilesIn(0, file.dir.path()).empty());
     EXPECT_EQ(fileCount(file.dir.path()), 1u);
     EXPECT_EQ(test::readBytes(file.path), file.bytes);
     EXPECT_EQ(readOms(file.path).info.pointCount, 50u);

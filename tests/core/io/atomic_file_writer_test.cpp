@@ -1,6 +1,7 @@
 // AtomicFileWriter::extendTo: the region a save fills out of order (the .omh's deep levels)
 // is reserved on a disk and only checked on a tmpfs, where reserving means zeroing memory.
 #include "io/atomic_file_writer.hpp"
+#include "run_process.hpp"
 #include "test_files.hpp"
 
 #include <cstdint>
@@ -102,8 +103,10 @@ TEST(AtomicFileWriterExtend, OnATmpfsTheRegionStaysSparseUntilWritten) {
     AtomicFileWriter file((dir.path() / "out.bin").string());
     constexpr std::uint64_t kSize = std::uint64_t{256} << 20;
     file.extendTo(kSize);
-    ASSERT_EQ(entriesIn(dir.path()), 1u);
-    const auto temporary = std::filesystem::directory_iterator(dir.path())->path();
+    EXPECT_EQ(entriesIn(dir.path()), 0u) << "the temporary has a name before it is complete";
+    const std::vector<std::filesystem::path> open = test::openFilesIn(0, dir.path());
+    ASSERT_EQ(open.size(), 1u);
+    const std::filesystem::path temporary = open.front();
     struct stat status {};
     ASSERT_EQ(::stat(temporary.c_str(), &status), 0);
     EXPECT_EQ(static_cast<std::uint64_t>(status.st_size), kSize);

@@ -1,10 +1,12 @@
 // Sorting beyond the memory budget: under a budget that forces runs on disk, the sorter emits
 // point for point what the in-memory sort emits (real scans and adversarial clouds), and its
-// scratch folder is gone after success, a reader failure, a cancel and a full disk.
+// scratch files, which have no names, are closed after success, a reader failure, a cancel and
+// a full disk.
 #include "io/input_error.hpp"
 #include "io/ply/ply_writer.hpp"
 #include "io/point_reader.hpp"
 #include "memory_budget.hpp"
+#include "run_process.hpp"
 #include "sort/morton_sorter.hpp"
 #include "test_files.hpp"
 
@@ -136,6 +138,7 @@ TEST_P(ExternalSort, RunsOnDiskGiveThePointsOfTheInMemorySort) {
     EXPECT_TRUE(external.complete);
     expectSamePoints(external.points, inMemory.points);
     EXPECT_EQ(entriesIn(scratch.path()), 0u) << "the runs outlived the sort";
+    EXPECT_EQ(test::openFilesIn(0, scratch.path()).size(), 0u) << "the runs outlived the sort";
 }
 
 INSTANTIATE_TEST_SUITE_P(Files, ExternalSort,
@@ -155,10 +158,12 @@ TEST(ExternalSortAdversarial, EqualCodesAcrossRunsKeepTheirInputOrder) {
         ASSERT_TRUE(sorter.spills());
         reader->read([&](const PointBatch& batch) { sorter.add(batch); });
         runs = sorter.runCount();
-        EXPECT_EQ(entriesIn(scratch.path()), 1u); // the sort's own folder, holding its runs
+        // The runs are open, and have no names: a killed process leaves none behind.
+        EXPECT_GE(test::openFilesIn(0, scratch.path()).size(), runs);
+        EXPECT_EQ(entriesIn(scratch.path()), 0u) << "a run has a name";
     }
     EXPECT_GT(runs, 3u);
-    EXPECT_EQ(entriesIn(scratch.path()), 0u) << "an abandoned sort left its runs";
+    EXPECT_EQ(test::openFilesIn(0, scratch.path()).size(), 0u) << "an abandoned sort left its runs";
     const Sorted external = sortFile(path, spilling);
     const Sorted inMemory = sortFile(path, SortOptions{});
     expectSamePoints(external.points, inMemory.points);
@@ -242,13 +247,15 @@ TEST(ExternalSortCleanup, AReaderFailureMidwayRemovesTheRuns) {
     test::TempDir dir;
     test::TempDir scratch;
     const LoadedCloud cloud = loadPointCloud(writeAdversarialCloud(dir, 200'000));
-    const SortOptions spilling = spillingOptions(scratch);
+    SortOptions spilling = spillingOptions(scratch);
+    // Packed: the cloud stays in memory, so every file open in the scratch folder is a run.
+    spilling.storage = PointStorage::Packed;
     const IncrementalMortonSorter* sorter = nullptr;
     std::size_t runsWhenFailing = 0;
-    std::size_t entriesWhenFailing = 0;
+    std::size_t filesWhenFailing = 0;
     FailingReader reader(cloud, 150'000, [&] {
         runsWhenFailing = sorter->runCount();
-        entriesWhenFailing = entriesIn(std::filesystem::directory_iterator(scratch.path())->path());
+        filesWhenFailing = test::openFilesIn(0, scratch.path()).size();
     });
     EXPECT_THROW(sortPointCloud(
                      reader, spilling, [](const SortedCloud&, std::size_t, std::size_t) {},
@@ -257,8 +264,9 @@ TEST(ExternalSortCleanup, AReaderFailureMidwayRemovesTheRuns) {
     EXPECT_GT(runsWhenFailing, 1u);
     // One file per run written, and one more for a run being written on the spilling thread
     // (the sorter's thread may start another between the two looks).
-    EXPECT_GE(entriesWhenFailing, runsWhenFailing) << "one file per run";
-    EXPECT_LE(entriesWhenFailing, runsWhenFailing + 2) << "one file per run";
+    EXPECT_GE(filesWhenFailing, runsWhenFailing) << "one file per run";
+    EXPECT_LE(filesWhenFailing, runsWhenFailing + 2) << "one file per run";
+    EXPECT_EQ(test::openFilesIn(0, scratch.path()).size(), 0u);
     EXPECT_EQ(entriesIn(scratch.path()), 0u);
 }
 
@@ -339,8 +347,8 @@ TEST(ExternalSortCleanup, AMissingScratchFolderIsAClearError) {
         FAIL() << "a sort spilled into a folder that does not exist";
     } catch (const OutputError& error) {
         EXPECT_EQ(std::string(error.what())
-                      .rfind("/nonexistent/omicron-scratch: cannot make a "
-                             "scratch folder",
+                      .rfind("/nonexistent/omicron-scratch: cannot make scratch files for "
+                             "the sorted runs there",
                              0),
                   0u)
             << error.what();
