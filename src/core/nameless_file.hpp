@@ -26,7 +26,7 @@ int openScratchFile(const std::string& folder, const std::string& stem);
 // Returns false with errno set (EEXIST when `path` exists).
 bool nameFile(int fd, const std::string& path);
 
-// Whether nameFile can work in this process: /proc is mounted.
+// Whether nameFile can name `fd`: its /proc/self/fd link exists (/proc is mounted here).
 bool canNameFiles(int fd);
 
 } // namespace omicron

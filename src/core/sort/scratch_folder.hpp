@@ -59,7 +59,6 @@ public:
     // that has nothing else to do).
     void willRead(std::uint64_t offset, std::uint64_t count) const;
     std::uint64_t size() const { return m_size; }
-    const std::string& name() const { return m_name; }
 
 private:
     ScratchFolder& m_folder;
