@@ -5,41 +5,16 @@
 // of its benchmark whose process is gone.
 #pragma once
 
-#include <cerrno>
-#include <csignal>
+#include "io/leftover_files.hpp"
+
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <unistd.h>
 
 namespace omicron::bench {
-
-// Removes the entries of the temp folder named `prefix`, a process number and, for a file,
-// `extension`, whose process is gone. Best effort: what it cannot list or remove stays.
-inline void removeStaleScratch(const std::string& prefix, const std::string& extension = "") {
-    namespace fs = std::filesystem;
-    try {
-        std::error_code error;
-        for (const auto& entry : fs::directory_iterator(fs::temp_directory_path(), error)) {
-            const std::string name = entry.path().filename().string();
-            if (!name.starts_with(prefix) || !name.ends_with(extension) ||
-                name.size() <= prefix.size() + extension.size()) {
-                continue;
-            }
-            const std::string digits =
-                name.substr(prefix.size(), name.size() - prefix.size() - extension.size());
-            if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) {
-                continue;
-            }
-            const auto pid = static_cast<pid_t>(std::stol(digits));
-            if (::kill(pid, 0) != 0 && errno == ESRCH) {
-                fs::remove_all(entry.path(), error);
-            }
-        }
-    } catch (const fs::filesystem_error&) {
-    }
-}
 
 // This run's scratch path, temp folder / PREFIX PID EXTENSION, after removing the stale ones;
 // removed (with what it holds) on destruction unless keep() was called.
@@ -49,7 +24,9 @@ public:
         : m_prefix(prefix), m_extension(extension),
           m_path(std::filesystem::temp_directory_path() /
                  (prefix + std::to_string(::getpid()) + extension)) {
-        removeStaleScratch(prefix, extension);
+        // A run killed before it could remove its own (Ctrl+C, a timeout) left it behind.
+        removeLeftoversOfGoneProcesses(std::filesystem::temp_directory_path(), prefix,
+                                       [&](std::string_view tail) { return tail == extension; });
     }
     ScratchPath(const ScratchPath&) = delete;
     ScratchPath& operator=(const ScratchPath&) = delete;
@@ -59,7 +36,7 @@ public:
             std::filesystem::remove_all(m_path, error);
             return;
         }
-        // Renamed to a name removeStaleScratch leaves alone.
+        // Renamed to a name the removal of leftovers leaves alone.
         const auto kept =
             m_path.parent_path() / (m_prefix + "kept-" + std::to_string(::getpid()) + m_extension);
         std::filesystem::rename(m_path, kept, error);

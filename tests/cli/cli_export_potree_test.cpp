@@ -128,6 +128,21 @@ TEST(CliExportPotree, ErrorsNameTheFileAndWhatIsWrong) {
     EXPECT_TRUE(std::filesystem::exists(dir.file("mine/notes.txt")));
 }
 
+// What an export run with OMICRON_TEST_PAUSE_POTREE_EXPORT=1 printed to `errPath` once it
+// paused (the first node written to the temporary folder), or after 60 s without a pause.
+std::string waitForPause(const std::string& errPath) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    std::string err;
+    while (err.find("paused") == std::string::npos && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        if (std::filesystem::exists(errPath)) {
+            const auto bytes = test::readBytes(errPath);
+            err.assign(bytes.begin(), bytes.end());
+        }
+    }
+    return err;
+}
+
 // Ctrl+C while octree.bin is being written: exit 130, no folder, no temporary folder, and an
 // export that was there before is still there, whole.
 TEST(CliExportPotree, InterruptedExportLeavesNothingHalfWritten) {
@@ -141,17 +156,7 @@ TEST(CliExportPotree, InterruptedExportLeavesNothingHalfWritten) {
         }
         test::RunningProcess child(OMICRON_CLI_PATH, {"export-potree", input, folder},
                                    {"OMICRON_TEST_PAUSE_POTREE_EXPORT=1"}, dir.file("err.txt"));
-        // Wait for the pause (the first node written to the temporary folder).
-        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-        std::string err;
-        while (err.find("paused") == std::string::npos &&
-               std::chrono::steady_clock::now() < deadline) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(20));
-            if (std::filesystem::exists(dir.file("err.txt"))) {
-                const auto bytes = test::readBytes(dir.file("err.txt"));
-                err.assign(bytes.begin(), bytes.end());
-            }
-        }
+        const std::string err = waitForPause(dir.file("err.txt"));
         ASSERT_NE(err.find("paused"), std::string::npos) << err;
         child.signal(SIGINT);
         EXPECT_EQ(child.waitFor(std::chrono::seconds(30)), std::optional<int>(130));
@@ -184,14 +189,7 @@ TEST(CliExportPotree, AKilledExportsFolderIsRemovedByTheNextExport) {
         auto child = std::make_unique<test::RunningProcess>(
             OMICRON_CLI_PATH, std::vector<std::string>{"export-potree", input, folder},
             std::vector<std::string>{"OMICRON_TEST_PAUSE_POTREE_EXPORT=1"}, dir.file(errName));
-        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-        std::string err;
-        while (err.find("paused") == std::string::npos &&
-               std::chrono::steady_clock::now() < deadline) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(20));
-            const auto bytes = test::readBytes(dir.file(errName));
-            err.assign(bytes.begin(), bytes.end());
-        }
+        const std::string err = waitForPause(dir.file(errName));
         EXPECT_NE(err.find("paused"), std::string::npos) << err;
         return child;
     };

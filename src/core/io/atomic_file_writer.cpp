@@ -52,8 +52,7 @@ AtomicFileWriter::AtomicFileWriter(std::string targetPath)
         ::close(m_fd); // it could never be renamed onto the target
         m_fd = -1;
     }
-    m_nameless = m_fd >= 0;
-    if (!m_nameless) {
+    if (m_fd < 0) {
         std::string pattern = m_tempPrefix + "XXXXXX";
         m_fd = ::mkostemp(pattern.data(), O_CLOEXEC);
         if (m_fd < 0) {
@@ -225,7 +224,7 @@ void AtomicFileWriter::commit() {
     if (::fsync(m_fd) != 0) {
         fail("fsync failed", errno);
     }
-    if (m_nameless) {
+    if (m_tempPath.empty()) {
         nameTemporary();
     }
     if (::close(m_fd) != 0) {

@@ -66,7 +66,6 @@ private:
     std::string m_targetPath;
     std::string m_tempPath; // empty while the temporary has no name
     std::string m_tempPrefix;
-    bool m_nameless = false;
     int m_fd = -1;
     std::vector<char> m_buffer;
     std::size_t m_buffered = 0;

@@ -1,6 +1,7 @@
 #include "io/atomic_folder.hpp"
 
 #include "io/atomic_file_writer.hpp"
+#include "io/leftover_files.hpp"
 
 #include <cerrno>
 #include <cstdio>
@@ -9,10 +10,8 @@
 #include <fcntl.h>
 #include <filesystem>
 #include <fstream>
-#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <vector>
 
 namespace omicron {
 
@@ -58,31 +57,6 @@ std::string makerToken() {
     return boot.substr(0, 8) + "." + namespaceNumber;
 }
 
-// Removes the temporary folders named `prefix` + "PID-XXXXXX" whose process no longer runs:
-// left by an export killed outright (SIGKILL, a crash, the out-of-memory killer), which no
-// destructor saw. A folder moved aside during a replace ("....old") is the previous export's
-// only copy if the process died between its two renames, and stays.
-void removeAbandoned(const fs::path& parent, const std::string& prefix) {
-    std::vector<fs::path> abandoned;
-    std::error_code error;
-    for (const auto& entry : fs::directory_iterator(parent, error)) {
-        const std::string name = entry.path().filename().string();
-        if (!name.starts_with(prefix)) {
-            continue;
-        }
-        const char* digits = name.c_str() + prefix.size();
-        char* end = nullptr;
-        const long pid = std::strtol(digits, &end, 10);
-        const bool wellFormed = end != digits && pid > 0 && *end == '-' && std::strlen(end) == 7;
-        if (wellFormed && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) {
-            abandoned.push_back(entry.path());
-        }
-    }
-    for (const fs::path& folder : abandoned) {
-        fs::remove_all(folder, error); // best effort: another export may be removing it too
-    }
-}
-
 void syncFolder(const fs::path& folder) {
     const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (fd >= 0) {
@@ -112,7 +86,11 @@ AtomicFolder::AtomicFolder(std::string targetPath, ReplaceCheck mayReplace)
     std::string prefix("."); // appended, not "." + ...: GCC 12 warns wrongly on that (restrict)
     prefix.append(target.filename().string()).append(".tmp-").append(token).append("-");
     if (!token.empty()) {
-        removeAbandoned(parent, prefix);
+        // Tails "-XXXXXX" only: a folder moved aside during a replace ("....old") is the old
+        // export's only copy if its process died between the two renames, and stays.
+        removeLeftoversOfGoneProcesses(parent, prefix, [](std::string_view tail) {
+            return tail.size() == 7 && tail.front() == '-';
+        });
     }
     std::string pattern = (parent / (prefix + std::to_string(::getpid()) + "-XXXXXX")).string();
     if (::mkdtemp(pattern.data()) == nullptr) {

@@ -1,0 +1,20 @@
+// Files and folders a process names after itself (PREFIX, its PID, then a tail) so that,
+// killed outright (SIGKILL, a crash, the out-of-memory killer) and unable to remove them, it
+// leaves them to the next process that makes the same kind: that one removes those whose PID
+// no longer runs. The Potree export's temporary folder and the benchmarks' scratch use it.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <string_view>
+
+namespace omicron {
+
+// Removes, with what they hold, the entries of `folder` named `prefix` + a PID + a tail that
+// `tailMatches` accepts, whose process is gone (kill(PID, 0) gives ESRCH). Best effort: what
+// cannot be listed or removed stays, and nothing is thrown.
+void removeLeftoversOfGoneProcesses(const std::filesystem::path& folder, const std::string& prefix,
+                                    const std::function<bool(std::string_view tail)>& tailMatches);
+
+} // namespace omicron
