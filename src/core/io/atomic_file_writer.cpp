@@ -1,8 +1,11 @@
 #include "io/atomic_file_writer.hpp"
 
+#include "io/leftover_files.hpp"
 #include "nameless_file.hpp"
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -43,10 +46,22 @@ AtomicFileWriter::AtomicFileWriter(std::string targetPath)
     }
     const std::filesystem::path folder =
         target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
-    std::string tempName = target.filename().string();
-    tempName.insert(0, 1, '.');
-    tempName.append(".tmp-");
-    m_tempPrefix = (folder / tempName).string();
+    // ".NAME.tmp-TOKEN-PID-" + a counter (named at commit) or mkostemp's six characters (named
+    // from the start): a process killed before its rename leaves such a name behind, and the
+    // next writer of the same target removes those whose process is gone.
+    const std::string token = processToken();
+    std::string prefix("."); // appended, not "." + ...: GCC 12 warns wrongly on that (restrict)
+    prefix.append(target.filename().string()).append(".tmp-");
+    if (!token.empty()) {
+        prefix.append(token).append("-");
+        removeLeftoversOfGoneProcesses(folder, prefix, [](std::string_view tail) {
+            return tail.size() >= 2 && tail.size() <= 21 && tail.front() == '-' &&
+                   std::all_of(tail.begin() + 1, tail.end(),
+                               [](char c) { return std::isalnum(static_cast<unsigned char>(c)); });
+        });
+    }
+    prefix.append(std::to_string(::getpid())).append("-");
+    m_tempPrefix = (folder / prefix).string();
     m_fd = openNamelessFile(folder.string(), 0600);
     if (m_fd >= 0 && !canNameFiles(m_fd)) {
         ::close(m_fd); // it could never be renamed onto the target
@@ -203,11 +218,11 @@ void AtomicFileWriter::dropFromCache(std::uint64_t offset, std::uint64_t count) 
 
 void AtomicFileWriter::nameTemporary() {
     // Unique among this process's saves by the counter and among processes by the PID; a
-    // name left by a process killed in the instant between this and the rename is skipped.
+    // name left by a process killed in the instant between this and the rename is skipped
+    // here, and removed by the next writer of the same target (see the constructor).
     static std::atomic<unsigned> counter{0};
     for (int attempt = 0; attempt < 1000; ++attempt) {
-        const std::string name =
-            m_tempPrefix + std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1));
+        const std::string name = m_tempPrefix + std::to_string(counter.fetch_add(1));
         if (nameFile(m_fd, name)) {
             m_tempPath = name;
             return;

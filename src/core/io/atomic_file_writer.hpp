@@ -3,7 +3,9 @@
 // target. Destroyed without commit() (an error, an exception), the temporary is removed. The
 // temporary has no name until commit() (nameless_file.hpp), so a process killed while it
 // writes leaves nothing behind; where the file system cannot make nameless files it is
-// ".NAME.tmp-XXXXXX" from the start.
+// ".NAME.tmp-TOKEN-PID-XXXXXX" from the start. Such names (and the one a process killed between
+// naming its temporary and the rename leaves) are removed by the next writer of the same target
+// once their process is gone (leftover_files.hpp).
 #pragma once
 
 #include <cstddef>

@@ -9,7 +9,6 @@
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
-#include <fstream>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -37,26 +36,6 @@ fs::path normalised(const std::string& path) {
     return target;
 }
 
-// This boot of this machine and this PID namespace, so that a PID in a temporary folder's name
-// means a process here only where the name carries the same token; "" where /proc cannot tell.
-std::string makerToken() {
-    std::ifstream bootFile("/proc/sys/kernel/random/boot_id");
-    std::string boot;
-    std::getline(bootFile, boot);
-    std::error_code error;
-    const std::string pidNamespace = fs::read_symlink("/proc/self/ns/pid", error).string();
-    std::string namespaceNumber; // "pid:[4026531836]" -> "4026531836"
-    for (const char c : pidNamespace) {
-        if (c >= '0' && c <= '9') {
-            namespaceNumber += c;
-        }
-    }
-    if (boot.size() < 8 || error || namespaceNumber.empty()) {
-        return "";
-    }
-    return boot.substr(0, 8) + "." + namespaceNumber;
-}
-
 void syncFolder(const fs::path& folder) {
     const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (fd >= 0) {
@@ -82,7 +61,7 @@ AtomicFolder::AtomicFolder(std::string targetPath, ReplaceCheck mayReplace)
                           " does not exist");
     }
     // ".NAME.tmp-TOKEN-PID-XXXXXX": the token and PID say whether its maker still runs.
-    const std::string token = makerToken();
+    const std::string token = processToken();
     std::string prefix("."); // appended, not "." + ...: GCC 12 warns wrongly on that (restrict)
     prefix.append(target.filename().string()).append(".tmp-").append(token).append("-");
     if (!token.empty()) {

@@ -3,10 +3,30 @@
 #include <cerrno>
 #include <climits>
 #include <cstdlib>
+#include <fstream>
 #include <signal.h>
 #include <vector>
 
 namespace omicron {
+
+std::string processToken() {
+    std::ifstream bootFile("/proc/sys/kernel/random/boot_id");
+    std::string boot;
+    std::getline(bootFile, boot);
+    std::error_code error;
+    const std::string pidNamespace =
+        std::filesystem::read_symlink("/proc/self/ns/pid", error).string();
+    std::string namespaceNumber; // "pid:[4026531836]" -> "4026531836"
+    for (const char c : pidNamespace) {
+        if (c >= '0' && c <= '9') {
+            namespaceNumber += c;
+        }
+    }
+    if (boot.size() < 8 || error || namespaceNumber.empty()) {
+        return "";
+    }
+    return boot.substr(0, 8) + "." + namespaceNumber;
+}
 
 void removeLeftoversOfGoneProcesses(const std::filesystem::path& folder, const std::string& prefix,
                                     const std::function<bool(std::string_view tail)>& tailMatches) {

@@ -1,7 +1,8 @@
 // Files and folders a process names after itself (PREFIX, its PID, then a tail) so that,
 // killed outright (SIGKILL, a crash, the out-of-memory killer) and unable to remove them, it
 // leaves them to the next process that makes the same kind: that one removes those whose PID
-// no longer runs. The Potree export's temporary folder and the benchmarks' scratch use it.
+// no longer runs. Save temporaries (AtomicFileWriter), the Potree export's temporary folder
+// and the benchmarks' scratch use it.
 #pragma once
 
 #include <filesystem>
@@ -10,6 +11,12 @@
 #include <string_view>
 
 namespace omicron {
+
+// This boot of this machine and this PID namespace ("BOOTID8.PIDNS"), to put in such names
+// before the PID: a PID means a process here only where the name carries the same token (a
+// folder shared over the network or with a container holds other machines' PIDs). "" where
+// /proc cannot tell; then nothing may be removed by PID.
+std::string processToken();
 
 // Removes, with what they hold, the entries of `folder` named `prefix` + a PID + a tail that
 // `tailMatches` accepts, whose process is gone (kill(PID, 0) gives ESRCH). Best effort: what

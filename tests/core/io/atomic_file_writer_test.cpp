@@ -1,9 +1,13 @@
 // AtomicFileWriter::extendTo: the region a save fills out of order (the .omh's deep levels)
-// is reserved on a disk and only checked on a tmpfs, where reserving means zeroing memory.
+// is reserved on a disk and only checked on a tmpfs, where reserving means zeroing memory; and
+// the temporaries a killed writer left are removed by the next writer of the same target.
 #include "io/atomic_file_writer.hpp"
+#include "io/leftover_files.hpp"
 #include "run_process.hpp"
 #include "test_files.hpp"
 
+#include <cerrno>
+#include <csignal>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +17,8 @@
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <sys/vfs.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <vector>
 
 namespace omicron {
@@ -135,6 +141,58 @@ TEST(AtomicFileWriterExtend, OnATmpfsWithoutTheRoomItIsAClearErrorAndNothingIsLe
             << message;
     }
     EXPECT_EQ(entriesIn(dir.path()), 0u) << "the temporary file was left behind";
+}
+
+// A PID whose process has ended (a child that exited and was reaped), or 0 where that PID was
+// taken again at once.
+pid_t pidOfAGoneProcess() {
+    const pid_t child = ::fork();
+    if (child == 0) {
+        ::_exit(0);
+    }
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    return ::kill(child, 0) != 0 && errno == ESRCH ? child : 0;
+}
+
+void touch(const std::filesystem::path& path) {
+    std::ofstream(path) << "left behind";
+}
+
+// A process killed between naming its finished temporary and renaming it (or one writing
+// where files cannot be nameless) leaves ".NAME.tmp-TOKEN-PID-…": the next writer of the same
+// target removes those of gone processes, and nothing of a running one or of another target.
+TEST(AtomicFileWriterLeftovers, TheNextWriterOfATargetRemovesTemporariesOfGoneProcesses) {
+    const std::string token = processToken();
+    if (token.empty()) {
+        GTEST_SKIP() << "/proc cannot tell this boot and PID namespace here";
+    }
+    const pid_t gone = pidOfAGoneProcess();
+    ASSERT_NE(gone, 0) << "the child's PID was reused at once";
+    test::TempDir dir;
+    const std::string prefix = ".out.bin.tmp-" + token + "-";
+    const std::string goneNamed = prefix + std::to_string(gone) + "-3";         // named at commit
+    const std::string goneFallback = prefix + std::to_string(gone) + "-aZ09xQ"; // mkostemp's
+    const std::string running = prefix + std::to_string(::getppid()) + "-0";
+    const std::string otherTarget = ".other.bin.tmp-" + token + "-" + std::to_string(gone) + "-0";
+    const std::string otherMachine = ".out.bin.tmp-0000beef.1-" + std::to_string(gone) + "-0";
+    const std::string notOurs = prefix + std::to_string(gone) + "-0.keep";
+    for (const std::string& name :
+         {goneNamed, goneFallback, running, otherTarget, otherMachine, notOurs}) {
+        touch(dir.path() / name);
+    }
+
+    AtomicFileWriter file(dir.file("out.bin"));
+    file.write(std::string("new"));
+    file.commit();
+
+    EXPECT_EQ(contentsOf(dir.file("out.bin")), (std::vector<char>{'n', 'e', 'w'}));
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / goneNamed));
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / goneFallback));
+    for (const std::string& kept : {running, otherTarget, otherMachine, notOurs}) {
+        EXPECT_TRUE(std::filesystem::exists(dir.path() / kept)) << kept << " was removed";
+    }
+    EXPECT_EQ(entriesIn(dir.path()), 5u);
 }
 
 } // namespace
