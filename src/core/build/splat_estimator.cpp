@@ -177,19 +177,6 @@ SplatScratch::Moments regionMoments(const SortedCloud& cloud, const SparseSplatR
 
 } // namespace
 
-void SplatScratch::Moments::add(const Moments& o) {
-    count += o.count;
-    sx += o.sx;
-    sy += o.sy;
-    sz += o.sz;
-    sxx += o.sxx;
-    sxy += o.sxy;
-    sxz += o.sxz;
-    syy += o.syy;
-    syz += o.syz;
-    szz += o.szz;
-}
-
 void estimateNodeSplats(const SortedCloud& cloud, const OctreeNode& node,
                         const SparseSplatRegion& sparseRegion, bool estimateNormals,
                         NodeSplats& out, SplatScratch& scratch) {
@@ -223,11 +210,13 @@ void estimateNodeSplats(const SortedCloud& cloud, const OctreeNode& node,
     bool regionSummed = false;
     SplatScratch::Moments region;
     const std::size_t cells = scratch.cellKeys.size();
-    // The widened estimate of the last sparse cell: its neighbours in Morton order usually
-    // share the same ancestor, so the sum is reused.
-    int cachedUp = -1;
-    morton::Code cachedAncestor = 0;
-    SplatScratch::Moments cached;
+    // The widened sums of the last sparse cell, one per level up: its neighbours in Morton
+    // order usually share the same ancestors, so each sum is reused. One cache for all levels
+    // made a cell that needed two levels up evict the level its next neighbour needed first
+    // (autzen_south tiled x5: 1.13 M sums over 13.8 M cells for 1.75 M sparse cells).
+    std::array<morton::Code, morton::kMaxLevel + 1> cachedAncestor;
+    cachedAncestor.fill(~morton::Code{0}); // no cell's ancestor
+    std::array<SplatScratch::Moments, morton::kMaxLevel + 1> cached;
     for (std::size_t c = 0; c < cells; ++c) {
         const SplatScratch::Moments* moments = &scratch.cellMoments[c];
         double density = moments->count;
@@ -235,7 +224,8 @@ void estimateNodeSplats(const SortedCloud& cloud, const OctreeNode& node,
         while (moments->count < kMinPointsPerEstimate && up < depth) {
             ++up;
             const morton::Code ancestor = scratch.cellKeys[c] >> (3 * up);
-            if (up != cachedUp || ancestor != cachedAncestor) {
+            SplatScratch::Moments& sum = cached[static_cast<std::size_t>(up)];
+            if (ancestor != cachedAncestor[static_cast<std::size_t>(up)]) {
                 // The ancestor's cells are one run of the sorted cell list around c.
                 std::size_t first = c, last = c + 1;
                 while (first > 0 && (scratch.cellKeys[first - 1] >> (3 * up)) == ancestor) {
@@ -244,15 +234,14 @@ void estimateNodeSplats(const SortedCloud& cloud, const OctreeNode& node,
                 while (last < cells && (scratch.cellKeys[last] >> (3 * up)) == ancestor) {
                     ++last;
                 }
-                cached = {};
+                sum = {};
                 for (std::size_t a = first; a < last; ++a) {
-                    cached.add(scratch.cellMoments[a]);
+                    sum.add(scratch.cellMoments[a]);
                 }
-                cachedUp = up;
-                cachedAncestor = ancestor;
+                cachedAncestor[static_cast<std::size_t>(up)] = ancestor;
             }
-            moments = &cached;
-            density = cached.count;
+            moments = &sum;
+            density = sum.count;
         }
         if (moments->count < kMinPointsPerEstimate && useRegion) {
             if (!regionSummed) {

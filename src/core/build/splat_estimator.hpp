@@ -63,7 +63,18 @@ struct SplatScratch {
             syz += y * z;
             szz += z * z;
         }
-        void add(const Moments& other);
+        void add(const Moments& other) { // inline: runs for every cell a sparse cell widens to
+            count += other.count;
+            sx += other.sx;
+            sy += other.sy;
+            sz += other.sz;
+            sxx += other.sxx;
+            sxy += other.sxy;
+            sxz += other.sxz;
+            syy += other.syy;
+            syz += other.syz;
+            szz += other.szz;
+        }
     };
     std::vector<morton::Code> cellKeys;   // fine-cell codes, ascending
     std::vector<std::uint32_t> cellFirst; // first held point of each cell (+ one past the last)
