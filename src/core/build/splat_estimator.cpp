@@ -10,6 +10,7 @@
 #include <cassert>
 #include <cmath>
 #include <glm/geometric.hpp>
+#include <optional>
 
 namespace omicron {
 
@@ -217,6 +218,9 @@ void estimateNodeSplats(const SortedCloud& cloud, const OctreeNode& node,
     std::array<morton::Code, morton::kMaxLevel + 1> cachedAncestor;
     cachedAncestor.fill(~morton::Code{0}); // no cell's ancestor
     std::array<SplatScratch::Moments, morton::kMaxLevel + 1> cached;
+    // And the estimate from each sum, once asked for: the cells that widen to the same
+    // ancestor get the same estimate (60 % of the fine cells of autzen_south x5 widen).
+    std::array<std::optional<CellEstimate>, morton::kMaxLevel + 1> cachedEstimate;
     for (std::size_t c = 0; c < cells; ++c) {
         const SplatScratch::Moments* moments = &scratch.cellMoments[c];
         double density = moments->count;
@@ -239,6 +243,7 @@ void estimateNodeSplats(const SortedCloud& cloud, const OctreeNode& node,
                     sum.add(scratch.cellMoments[a]);
                 }
                 cachedAncestor[static_cast<std::size_t>(up)] = ancestor;
+                cachedEstimate[static_cast<std::size_t>(up)].reset();
             }
             moments = &sum;
             density = sum.count;
@@ -252,8 +257,14 @@ void estimateNodeSplats(const SortedCloud& cloud, const OctreeNode& node,
             density = static_cast<double>(sparseRegion.nodePoints);
         }
         const double cellEdge = fineEdge * static_cast<double>(std::uint32_t{1} << up);
-        const CellEstimate estimate =
-            estimateCell(*moments, density, cellEdge, nodeEdge, estimateNormals);
+        std::optional<CellEstimate> own;
+        std::optional<CellEstimate>& slot = moments == &cached[static_cast<std::size_t>(up)]
+                                                ? cachedEstimate[static_cast<std::size_t>(up)]
+                                                : own;
+        if (!slot) {
+            slot = estimateCell(*moments, density, cellEdge, nodeEdge, estimateNormals);
+        }
+        const CellEstimate estimate = *slot;
         const std::uint32_t first = scratch.cellFirst[c];
         const std::uint32_t cellPoints = scratch.cellFirst[c + 1] - first;
         std::fill_n(out.radii.begin() + first, cellPoints, encodeRadius(estimate.radius));
