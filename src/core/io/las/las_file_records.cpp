@@ -7,8 +7,11 @@
 namespace omicron {
 
 namespace {
-// Records are read in blocks of whole records of about this size.
-constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
+// Records are read in blocks of whole records of about this size: small enough that the block
+// the read-ahead task copied is still in the caches when both cores parse it (24.2 M-point
+// LAS, 10 builds each alternating: read phase 0.376 s with 4 MiB blocks, 0.365 s with 1 MiB;
+// terrascan x35, whose records have every field set: 0.434 s against 0.398 s).
+constexpr std::size_t kBlockBytes = std::size_t{1} << 20;
 } // namespace
 
 LasFileRecords::LasFileRecords(std::unique_ptr<FileStream> stream, const las::Header& header)
