@@ -211,25 +211,27 @@ void estimateNodeSplats(const SortedCloud& cloud, const OctreeNode& node,
     bool regionSummed = false;
     SplatScratch::Moments region;
     const std::size_t cells = scratch.cellKeys.size();
-    // The widened sums of the last sparse cell, one per level up: its neighbours in Morton
-    // order usually share the same ancestors, so each sum is reused. One cache for all levels
-    // made a cell that needed two levels up evict the level its next neighbour needed first
-    // (autzen_south tiled x5: 1.13 M sums over 13.8 M cells for 1.75 M sparse cells).
-    std::array<morton::Code, morton::kMaxLevel + 1> cachedAncestor;
-    cachedAncestor.fill(~morton::Code{0}); // no cell's ancestor
-    std::array<SplatScratch::Moments, morton::kMaxLevel + 1> cached;
-    // And the estimate from each sum, once asked for: the cells that widen to the same
-    // ancestor get the same estimate (60 % of the fine cells of autzen_south x5 widen).
-    std::array<std::optional<CellEstimate>, morton::kMaxLevel + 1> cachedEstimate;
+    // The widened sum of the last sparse cell, one per level up, and the estimate from it once
+    // asked for: its neighbours in Morton order usually widen to the same ancestors, and get
+    // the same sum and estimate. One cache for all levels made a cell that needed two levels up
+    // evict the level its next neighbour needed first (autzen_south tiled x5: 1.13 M sums over
+    // 13.8 M cells for 1.75 M sparse cells, 60 % of its fine cells).
+    struct Widened {
+        morton::Code ancestor = ~morton::Code{0}; // no cell's ancestor
+        SplatScratch::Moments sum;
+        std::optional<CellEstimate> estimate;
+    };
+    std::array<Widened, morton::kMaxLevel + 1> widened;
     for (std::size_t c = 0; c < cells; ++c) {
         const SplatScratch::Moments* moments = &scratch.cellMoments[c];
         double density = moments->count;
         int up = 0;
+        Widened* level = nullptr; // where the moments come from when widened
         while (moments->count < kMinPointsPerEstimate && up < depth) {
             ++up;
             const morton::Code ancestor = scratch.cellKeys[c] >> (3 * up);
-            SplatScratch::Moments& sum = cached[static_cast<std::size_t>(up)];
-            if (ancestor != cachedAncestor[static_cast<std::size_t>(up)]) {
+            level = &widened[static_cast<std::size_t>(up)];
+            if (ancestor != level->ancestor) {
                 // The ancestor's cells are one run of the sorted cell list around c.
                 std::size_t first = c, last = c + 1;
                 while (first > 0 && (scratch.cellKeys[first - 1] >> (3 * up)) == ancestor) {
@@ -238,15 +240,15 @@ void estimateNodeSplats(const SortedCloud& cloud, const OctreeNode& node,
                 while (last < cells && (scratch.cellKeys[last] >> (3 * up)) == ancestor) {
                     ++last;
                 }
-                sum = {};
+                level->sum = {};
                 for (std::size_t a = first; a < last; ++a) {
-                    sum.add(scratch.cellMoments[a]);
+                    level->sum.add(scratch.cellMoments[a]);
                 }
-                cachedAncestor[static_cast<std::size_t>(up)] = ancestor;
-                cachedEstimate[static_cast<std::size_t>(up)].reset();
+                level->ancestor = ancestor;
+                level->estimate.reset();
             }
-            moments = &sum;
-            density = sum.count;
+            moments = &level->sum;
+            density = level->sum.count;
         }
         if (moments->count < kMinPointsPerEstimate && useRegion) {
             if (!regionSummed) {
@@ -255,12 +257,11 @@ void estimateNodeSplats(const SortedCloud& cloud, const OctreeNode& node,
             }
             moments = &region;
             density = static_cast<double>(sparseRegion.nodePoints);
+            level = nullptr;
         }
         const double cellEdge = fineEdge * static_cast<double>(std::uint32_t{1} << up);
         std::optional<CellEstimate> own;
-        std::optional<CellEstimate>& slot = moments == &cached[static_cast<std::size_t>(up)]
-                                                ? cachedEstimate[static_cast<std::size_t>(up)]
-                                                : own;
+        std::optional<CellEstimate>& slot = level != nullptr ? level->estimate : own;
         if (!slot) {
             slot = estimateCell(*moments, density, cellEdge, nodeEdge, estimateNormals);
         }

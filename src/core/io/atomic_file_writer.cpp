@@ -50,10 +50,8 @@ AtomicFileWriter::AtomicFileWriter(std::string targetPath)
     // from the start): a process killed before its rename leaves such a name behind, and the
     // next writer of the same target removes those whose process is gone.
     const std::string token = processToken();
-    std::string prefix("."); // appended, not "." + ...: GCC 12 warns wrongly on that (restrict)
-    prefix.append(target.filename().string()).append(".tmp-");
+    std::string prefix = temporaryPrefix(target.filename().string(), token);
     if (!token.empty()) {
-        prefix.append(token).append("-");
         removeLeftoversOfGoneProcesses(folder, prefix, [](std::string_view tail) {
             return tail.size() >= 2 && tail.size() <= 21 && tail.front() == '-' &&
                    std::all_of(tail.begin() + 1, tail.end(),

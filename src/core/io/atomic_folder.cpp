@@ -62,8 +62,7 @@ AtomicFolder::AtomicFolder(std::string targetPath, ReplaceCheck mayReplace)
     }
     // ".NAME.tmp-TOKEN-PID-XXXXXX": the token and PID say whether its maker still runs.
     const std::string token = processToken();
-    std::string prefix("."); // appended, not "." + ...: GCC 12 warns wrongly on that (restrict)
-    prefix.append(target.filename().string()).append(".tmp-").append(token).append("-");
+    const std::string prefix = temporaryPrefix(target.filename().string(), token);
     if (!token.empty()) {
         // Tails "-XXXXXX" only: a folder moved aside during a replace ("....old") is the old
         // export's only copy if its process died between the two renames, and stays.

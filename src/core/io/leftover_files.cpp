@@ -28,6 +28,15 @@ std::string processToken() {
     return boot.substr(0, 8) + "." + namespaceNumber;
 }
 
+std::string temporaryPrefix(const std::string& name, const std::string& token) {
+    std::string prefix("."); // appended, not "." + ...: GCC 12 warns wrongly on that (restrict)
+    prefix.append(name).append(".tmp-");
+    if (!token.empty()) {
+        prefix.append(token).append("-");
+    }
+    return prefix;
+}
+
 void removeLeftoversOfGoneProcesses(const std::filesystem::path& folder, const std::string& prefix,
                                     const std::function<bool(std::string_view tail)>& tailMatches) {
     namespace fs = std::filesystem;

@@ -18,6 +18,11 @@ namespace omicron {
 // /proc cannot tell; then nothing may be removed by PID.
 std::string processToken();
 
+// ".NAME.tmp-TOKEN-" (".NAME.tmp-" for an empty token): how the name of a temporary standing in
+// for the file or folder NAME begins, before its maker's PID. Save temporaries and the Potree
+// export's temporary folder are named so.
+std::string temporaryPrefix(const std::string& name, const std::string& token);
+
 // Removes, with what they hold, the entries of `folder` named `prefix` + a PID + a tail that
 // `tailMatches` accepts, whose process is gone (kill(PID, 0) gives ESRCH). Best effort: what
 // cannot be listed or removed stays, and nothing is thrown.
