@@ -48,16 +48,22 @@ void FileStream::seek(std::uint64_t offset) {
 }
 
 std::size_t FileStream::read(void* destination, std::size_t count) {
+    const std::size_t done = readAt(m_position, destination, count);
+    m_position += done;
+    return done;
+}
+
+std::size_t FileStream::readAt(std::uint64_t offset, void* destination, std::size_t count) const {
     auto* out = static_cast<char*>(destination);
     std::size_t done = 0;
     while (done < count) {
-        const ssize_t got = ::read(m_fd, out + done, count - done);
+        const ssize_t got =
+            ::pread(m_fd, out + done, count - done, static_cast<off_t>(offset + done));
         if (got < 0) {
             if (errno == EINTR) {
                 continue;
             }
-            throw InputError(InputErrorKind::CannotOpen, m_path,
-                             InputLocation::byte(m_position + done),
+            throw InputError(InputErrorKind::CannotOpen, m_path, InputLocation::byte(offset + done),
                              std::string("read error: ") + std::strerror(errno));
         }
         if (got == 0) {
@@ -65,7 +71,6 @@ std::size_t FileStream::read(void* destination, std::size_t count) {
         }
         done += static_cast<std::size_t>(got);
     }
-    m_position += done;
     return done;
 }
 

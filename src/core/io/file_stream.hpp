@@ -1,5 +1,6 @@
 // Sequential binary reads from a file with the absolute offset always known, so errors can
 // name the byte. Thin wrapper over POSIX read(): callers read in large blocks themselves.
+// readAt() reads at an offset without moving the position (pread), from any thread.
 #pragma once
 
 #include <cstddef>
@@ -25,6 +26,10 @@ public:
 
     // Reads up to `count` bytes; returns fewer only at the end of the file.
     std::size_t read(void* destination, std::size_t count);
+
+    // Reads up to `count` bytes from byte `offset`, leaving position() as it is; returns fewer
+    // only at the end of the file. Safe to call from several threads at once.
+    std::size_t readAt(std::uint64_t offset, void* destination, std::size_t count) const;
 
     // Reads exactly `count` bytes or throws Truncated: "expected <what>, the file ends".
     void readExact(void* destination, std::size_t count, const std::string& what);

@@ -54,11 +54,13 @@ struct OpenOptions {
     // file before any point is delivered) checks this once per block of input (1 to 4 MiB)
     // and stops with OpenCancelled when it is set.
     const std::atomic<bool>* cancel = nullptr;
-    // Called on the opening thread as the pre-pass advances (once per block, at its start and
-    // at its end) with the bytes scanned and the file's size; it may set *cancel.
+    // Called as the pre-pass advances (once per block, at its start and at its end) with the
+    // bytes scanned and the file's size; it may set *cancel. One call at a time and in file
+    // order, on the opening thread or, for a binary PLY (scanned on every core), on a oneTBB
+    // worker of its arena.
     std::function<void(std::uint64_t bytesScanned, std::uint64_t fileBytes)> onPrePassProgress;
-    // Called before each progress report (same thread) with the source positions the pre-pass
-    // sampled since the last one: an evenly strided sample of about kPrePassSamplePoints
+    // Called before each progress report (same thread as the report) with the source positions the
+    // pre-pass sampled since the last one: an evenly strided sample of about kPrePassSamplePoints
     // finite points over the file, so a viewer can draw the cloud in a provisional frame
     // while its bounds are still being found (the first pixels of a large PLY or XYZ file).
     std::function<void(std::span<const glm::dvec3> sourcePositions)> onPrePassPoints;

@@ -164,9 +164,10 @@ public:
     // the kept hierarchy), so that one cancel() stops whichever runs.
     const std::atomic<bool>& cancelFlag() const { return m_cancel; }
 
-    // Called on the run's thread as the bounds pre-pass of a cloud file advances (see
-    // OpenOptions::onPrePassProgress); it may call cancel(). progress() has the same numbers
-    // for pollers. Set it between runs, not during one.
+    // Called as the bounds pre-pass of a cloud file advances, one call at a time, on the run's
+    // thread or a oneTBB worker it waits for (see OpenOptions::onPrePassProgress); it may call
+    // cancel(). progress() has the same numbers for pollers. Set it between runs, not during
+    // one.
     using PrePassObserver =
         std::function<void(std::uint64_t bytesScanned, std::uint64_t fileBytes)>;
     void setPrePassObserver(PrePassObserver observer) { m_prePassObserver = std::move(observer); }

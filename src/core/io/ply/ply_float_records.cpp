@@ -111,37 +111,56 @@ void extendScalar(const std::uint8_t* records, std::size_t count, const FloatRec
     box.finite += finite;
 }
 
-// The optional float normal and uchar colour of one record, shared by both conversions.
-template <bool kNormals, bool kColors>
-inline void copyOptionalAttributes(const std::uint8_t* record, std::array<std::size_t, 3> normalAt,
-                                   std::array<std::size_t, 3> colorAt, glm::vec3* normal,
-                                   glm::u8vec3* color) {
+// Where a record's optional attributes are and where they go: locals of the conversion loops
+// (byte stores may alias anything, which would reload a struct's fields per point).
+struct AttributeCopy {
+    std::array<std::size_t, 3> normalAt{};
+    std::array<std::size_t, 3> colorAt{};
+    std::size_t intensityAt = 0;
+    glm::vec3* normals = nullptr;
+    glm::u8vec3* colors = nullptr;
+    std::uint16_t* intensities = nullptr;
+};
+
+// The optional float normal, uchar colour and ushort intensity of record r, shared by both
+// conversions. Only present arrays are indexed: arithmetic on an absent array's null pointer is
+// undefined behaviour (found by fuzz_ply under UBSan).
+template <bool kNormals, bool kColors, bool kIntensity>
+inline void copyOptionalAttributes(const std::uint8_t* record, std::size_t r,
+                                   const AttributeCopy& copy) {
     if constexpr (kNormals) {
-        *normal = glm::vec3(loadFloat(record + normalAt[0]), loadFloat(record + normalAt[1]),
-                            loadFloat(record + normalAt[2]));
+        copy.normals[r] =
+            glm::vec3(loadFloat(record + copy.normalAt[0]), loadFloat(record + copy.normalAt[1]),
+                      loadFloat(record + copy.normalAt[2]));
     }
     if constexpr (kColors) {
-        *color = glm::u8vec3(record[colorAt[0]], record[colorAt[1]], record[colorAt[2]]);
+        copy.colors[r] =
+            glm::u8vec3(record[copy.colorAt[0]], record[copy.colorAt[1]], record[copy.colorAt[2]]);
+    }
+    if constexpr (kIntensity) {
+        std::memcpy(&copy.intensities[r], record + copy.intensityAt, sizeof(std::uint16_t));
     }
 }
 
-template <bool kNormals, bool kColors>
+AttributeCopy attributeCopy(const FloatRecordLayout& layout, const FloatRecordOutputs& outputs) {
+    return {layout.normal,   layout.color,   layout.intensity,
+            outputs.normals, outputs.colors, outputs.intensities};
+}
+
+template <bool kNormals, bool kColors, bool kIntensity>
 std::size_t convertScalar(const std::uint8_t* records, std::size_t count,
                           const FloatRecordLayout& layout, const FloatUnitTransform& transform,
                           const FloatRecordOutputs& outputs) {
     // Locals: the colour byte stores may alias anything, which would reload these per point.
     const std::size_t stride = layout.recordBytes;
     const std::array<std::size_t, 3> positionAt = layout.position;
-    const std::array<std::size_t, 3> normalAt = layout.normal;
-    const std::array<std::size_t, 3> colorAt = layout.color;
+    const AttributeCopy copy = attributeCopy(layout, outputs);
     const std::array<float, 3> low = transform.low;
     const std::array<float, 3> high = transform.high;
     const glm::dvec3 offset = transform.offset;
     const glm::dvec3 origin = transform.origin;
     const double inverseEdge = transform.inverseEdge;
     glm::vec3* const positions = outputs.positions;
-    glm::vec3* const normals = outputs.normals;
-    glm::u8vec3* const colors = outputs.colors;
     for (std::size_t r = 0; r < count; ++r) {
         const std::uint8_t* record = records + r * stride;
         const float x = loadFloat(record + positionAt[0]);
@@ -155,11 +174,7 @@ std::size_t convertScalar(const std::uint8_t* records, std::size_t count,
                                 static_cast<double>(y) + offset.y,
                                 static_cast<double>(z) + offset.z);
         positions[r] = glm::vec3((source - origin) * inverseEdge);
-        // No arithmetic on an absent array's null pointer (undefined behaviour; found by
-        // fuzz_ply under UBSan).
-        copyOptionalAttributes<kNormals, kColors>(record, normalAt, colorAt,
-                                                  kNormals ? normals + r : nullptr,
-                                                  kColors ? colors + r : nullptr);
+        copyOptionalAttributes<kNormals, kColors, kIntensity>(record, r, copy);
     }
     return count;
 }
@@ -210,7 +225,7 @@ void extendSse2(const std::uint8_t* records, std::size_t count, const FloatRecor
     box.finite += finite;
 }
 
-template <bool kNormals, bool kColors>
+template <bool kNormals, bool kColors, bool kIntensity>
 std::size_t convertSse2(const std::uint8_t* records, std::size_t count,
                         const FloatRecordLayout& layout, const FloatUnitTransform& transform,
                         const FloatRecordOutputs& outputs) {
@@ -225,11 +240,8 @@ std::size_t convertSse2(const std::uint8_t* records, std::size_t count,
     // Locals: the colour byte stores may alias anything, which would reload `layout` per point.
     const std::size_t stride = layout.recordBytes;
     const std::size_t xyzAt = layout.position[0];
-    const std::array<std::size_t, 3> normalAt = layout.normal;
-    const std::array<std::size_t, 3> colorAt = layout.color;
+    const AttributeCopy copy = attributeCopy(layout, outputs);
     glm::vec3* const positions = outputs.positions;
-    glm::vec3* const normals = outputs.normals;
-    glm::u8vec3* const colors = outputs.colors;
     for (std::size_t r = 0; r < count; ++r) {
         const std::uint8_t* record = records + r * stride;
         // The fourth lane holds the next field's bytes: zeroed, it cannot be a slow denormal.
@@ -248,26 +260,33 @@ std::size_t convertSse2(const std::uint8_t* records, std::size_t count,
         float* position = &positions[r].x;
         _mm_storel_pi(reinterpret_cast<__m64*>(position), unit);
         _mm_store_ss(position + 2, _mm_movehl_ps(unit, unit));
-        // No arithmetic on an absent array's null pointer (undefined behaviour; found by
-        // fuzz_ply under UBSan).
-        copyOptionalAttributes<kNormals, kColors>(record, normalAt, colorAt,
-                                                  kNormals ? normals + r : nullptr,
-                                                  kColors ? colors + r : nullptr);
+        copyOptionalAttributes<kNormals, kColors, kIntensity>(record, r, copy);
     }
     return count;
 }
 
 #endif
 
-template <bool kNormals, bool kColors>
+template <bool kNormals, bool kColors, bool kIntensity>
 std::size_t convert(const std::uint8_t* records, std::size_t count, const FloatRecordLayout& layout,
                     const FloatUnitTransform& transform, const FloatRecordOutputs& outputs) {
 #if defined(__SSE2__)
     if (layout.adjacentPosition()) {
-        return convertSse2<kNormals, kColors>(records, count, layout, transform, outputs);
+        return convertSse2<kNormals, kColors, kIntensity>(records, count, layout, transform,
+                                                          outputs);
     }
 #endif
-    return convertScalar<kNormals, kColors>(records, count, layout, transform, outputs);
+    return convertScalar<kNormals, kColors, kIntensity>(records, count, layout, transform, outputs);
+}
+
+template <bool kNormals, bool kColors>
+std::size_t convertChoosingIntensity(const std::uint8_t* records, std::size_t count,
+                                     const FloatRecordLayout& layout,
+                                     const FloatUnitTransform& transform,
+                                     const FloatRecordOutputs& outputs) {
+    return layout.hasIntensity
+               ? convert<kNormals, kColors, true>(records, count, layout, transform, outputs)
+               : convert<kNormals, kColors, false>(records, count, layout, transform, outputs);
 }
 
 } // namespace
@@ -288,15 +307,15 @@ std::size_t convertFloatRecords(const std::uint8_t* records, std::size_t count,
                                 const FloatUnitTransform& transform,
                                 const FloatRecordOutputs& outputs) {
     if (layout.hasNormals && layout.hasColors) {
-        return convert<true, true>(records, count, layout, transform, outputs);
+        return convertChoosingIntensity<true, true>(records, count, layout, transform, outputs);
     }
     if (layout.hasNormals) {
-        return convert<true, false>(records, count, layout, transform, outputs);
+        return convertChoosingIntensity<true, false>(records, count, layout, transform, outputs);
     }
     if (layout.hasColors) {
-        return convert<false, true>(records, count, layout, transform, outputs);
+        return convertChoosingIntensity<false, true>(records, count, layout, transform, outputs);
     }
-    return convert<false, false>(records, count, layout, transform, outputs);
+    return convertChoosingIntensity<false, false>(records, count, layout, transform, outputs);
 }
 
 } // namespace omicron

@@ -1,7 +1,7 @@
 // Hot loops for the common binary PLY layout: native-endian float x y z, optionally float
-// normals and uchar colours, no lists. Both loops do only loads, a few compares and the
-// SourceNormalizer arithmetic, with an SSE2 path when x y z are adjacent; everything unusual
-// (non-finite points, points at or outside the bounds) is left to the caller's exact code.
+// normals, uchar colours and a ushort intensity, no lists. Both loops do only loads, a few compares
+// and the SourceNormalizer arithmetic, with an SSE2 path when x y z are adjacent; everything
+// unusual (non-finite points, points at or outside the bounds) is left to the caller's exact code.
 #pragma once
 
 #include "io/source_normalizer.hpp"
@@ -25,6 +25,8 @@ struct FloatRecordLayout {
     std::array<std::size_t, 3> normal{}; // float
     bool hasColors = false;
     std::array<std::size_t, 3> color{}; // uchar
+    bool hasIntensity = false;
+    std::size_t intensity = 0; // ushort
 
     bool adjacentPosition() const {
         return position[1] == position[0] + 4 && position[2] == position[0] + 8;
@@ -66,12 +68,13 @@ struct FloatRecordOutputs {
     glm::vec3* positions = nullptr;
     glm::vec3* normals = nullptr;  // when the layout has normals
     glm::u8vec3* colors = nullptr; // when the layout has colours
+    std::uint16_t* intensities = nullptr; // when the layout has an intensity
 };
 
 // Converts records in order while each lies inside the transform's box, writing position i
 // as float(((double(x) + offset) - origin) * inverseEdge), exactly SourceNormalizer::toUnit,
-// plus its normal and colour. Returns how many were converted: `count`, or the index of the
-// first record that needs the caller's exact handling.
+// plus its normal, colour and intensity. Returns how many were converted: `count`, or the index of
+// the first record that needs the caller's exact handling.
 std::size_t convertFloatRecords(const std::uint8_t* records, std::size_t count,
                                 const FloatRecordLayout& layout,
                                 const FloatUnitTransform& transform,

@@ -3,6 +3,7 @@
 #include "io/file_stream.hpp"
 #include "io/input_error.hpp"
 #include "io/line_reader.hpp"
+#include "io/parallel_record_scan.hpp"
 #include "io/ply/ply_float_records.hpp"
 #include "io/ply/ply_header.hpp"
 #include "io/ply/ply_values.hpp"
@@ -16,6 +17,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <tbb/enumerable_thread_specific.h>
 
 namespace omicron {
 
@@ -183,6 +185,8 @@ private:
     template <typename OnBlock> bool visitFixedBlocks(OnBlock&& onBlock);
     template <typename OnVertex> bool visitVertexValues(OnVertex&& onVertex);
     void loadUsedValues(const std::uint8_t* record, double* values) const;
+    bool hasType(const std::array<int, 3>& fields, PlyScalarType type) const;
+    bool floatPositions() const;
     bool fastLayout() const;
     FloatRecordLayout floatLayout() const;
     bool readFastLayout(const SourceNormalizer& normalizer, BatchSink& sink, ReadSummary& summary);
@@ -625,19 +629,27 @@ void PlyReader::loadUsedValues(const std::uint8_t* record, double* values) const
     }
 }
 
-// The layout of ../shared/data and most scanners: native-endian float x y z, optionally float
-// normals and uchar colours, no lists and no intensity.
+bool PlyReader::hasType(const std::array<int, 3>& fields, PlyScalarType type) const {
+    return std::all_of(fields.begin(), fields.end(),
+                       [&](int p) { return vertex().properties[p].type == type; });
+}
+
+// Fixed-size native-endian records with float x y z: enough for the bounds pre-pass's loop,
+// whatever the other properties are.
+bool PlyReader::floatPositions() const {
+    return binary() && m_fixedRecords && !m_swapBytes &&
+           hasType(m_fields.position, PlyScalarType::Float32);
+}
+
+// The layout of ../shared/data, most scanners and our own converter: float positions,
+// optionally float normals, uchar colours and a ushort intensity (other intensity types need
+// plyIntensity's rounding and clamping).
 bool PlyReader::fastLayout() const {
-    if (!binary() || !m_fixedRecords || m_swapBytes || m_fields.hasIntensity()) {
-        return false;
-    }
-    const auto all = [&](const std::array<int, 3>& fields, PlyScalarType type) {
-        return std::all_of(fields.begin(), fields.end(),
-                           [&](int p) { return vertex().properties[p].type == type; });
-    };
-    return all(m_fields.position, PlyScalarType::Float32) &&
-           (!m_fields.hasNormals() || all(m_fields.normal, PlyScalarType::Float32)) &&
-           (!m_fields.hasColors() || all(m_fields.color, PlyScalarType::UInt8));
+    return floatPositions() &&
+           (!m_fields.hasNormals() || hasType(m_fields.normal, PlyScalarType::Float32)) &&
+           (!m_fields.hasColors() || hasType(m_fields.color, PlyScalarType::UInt8)) &&
+           (!m_fields.hasIntensity() ||
+            vertex().properties[m_fields.intensity].type == PlyScalarType::UInt16);
 }
 
 FloatRecordLayout PlyReader::floatLayout() const {
@@ -654,6 +666,10 @@ FloatRecordLayout PlyReader::floatLayout() const {
     }
     layout.hasNormals = m_fields.hasNormals();
     layout.hasColors = m_fields.hasColors();
+    layout.hasIntensity = m_fields.hasIntensity();
+    if (layout.hasIntensity) {
+        layout.intensity = m_propertyOffsets[m_fields.intensity];
+    }
     return layout;
 }
 
@@ -662,32 +678,59 @@ void PlyReader::runBoundsPrePass(const OpenOptions& options) {
     std::uint64_t finite = 0;
     PrePassMonitor monitor(options, m_stream.path(), m_stream.size(), m_info.pointCount);
     monitor.advance(m_vertexStart);
-    if (fastLayout()) {
+    if (floatPositions()) {
         // Min/max of the stored floats, offset added once at the end: double(x) + offset is
-        // monotonic in x, so this equals the per-point bounds read() checks against.
+        // monotonic in x, so this equals the per-point bounds read() checks against. The blocks
+        // are read and scanned on every core (a scan is mostly the kernel's copy); each thread
+        // keeps its own box, and the sample and the progress go on in file order.
         const FloatRecordLayout layout = floatLayout();
-        FloatBox box;
-        visitFixedBlocks(
-            [&](const std::uint8_t* records, std::size_t count, std::uint64_t firstIndex) {
-                extendFloatBox(records, count, layout, box);
-                if (monitor.samples(0)) {
-                    const std::uint64_t stride = monitor.sampleStride();
-                    for (std::uint64_t i = (firstIndex + stride - 1) / stride * stride;
-                         i < firstIndex + count; i += stride) {
-                        const std::uint8_t* record = records + (i - firstIndex) * m_recordBytes;
-                        glm::dvec3 source;
-                        for (int axis = 0; axis < 3; ++axis) {
-                            float value;
-                            std::memcpy(&value, record + layout.position[axis], sizeof value);
-                            source[axis] = double(value) + m_header.offset[axis];
-                        }
-                        if (SourceNormalizer::isFinite(source)) {
-                            monitor.offer(source);
-                        }
+        const RecordArray array{m_vertexStart, m_recordBytes, vertex().count};
+        const bool sampling = monitor.samples(0);
+        const std::uint64_t stride = monitor.sampleStride();
+        std::vector<std::vector<glm::dvec3>> blockSamples(
+            sampling ? static_cast<std::size_t>(recordBlockCount(array, kBlockBytes)) : 0);
+        tbb::enumerable_thread_specific<FloatBox> boxes;
+        scanRecordsInParallel(
+            m_stream, array, kBlockBytes, kFloatRecordPadding,
+            [&](const std::uint8_t* records, std::size_t count, std::uint64_t firstIndex,
+                std::uint64_t block) {
+                extendFloatBox(records, count, layout, boxes.local());
+                if (!sampling) {
+                    return;
+                }
+                std::vector<glm::dvec3>& samples = blockSamples[static_cast<std::size_t>(block)];
+                for (std::uint64_t i = (firstIndex + stride - 1) / stride * stride;
+                     i < firstIndex + count; i += stride) {
+                    const std::uint8_t* record = records + (i - firstIndex) * m_recordBytes;
+                    glm::dvec3 source;
+                    for (int axis = 0; axis < 3; ++axis) {
+                        float value;
+                        std::memcpy(&value, record + layout.position[axis], sizeof value);
+                        source[axis] = double(value) + m_header.offset[axis];
+                    }
+                    if (SourceNormalizer::isFinite(source)) {
+                        samples.push_back(source);
                     }
                 }
-                return monitor.reached(m_vertexStart + (firstIndex + count) * m_recordBytes);
+            },
+            [&](std::uint64_t block, std::uint64_t endByte) {
+                if (sampling) {
+                    std::vector<glm::dvec3> samples;
+                    std::swap(samples, blockSamples[static_cast<std::size_t>(block)]);
+                    for (const glm::dvec3& source : samples) {
+                        monitor.offer(source);
+                    }
+                }
+                return monitor.reached(endByte);
             });
+        FloatBox box;
+        boxes.combine_each([&](const FloatBox& part) {
+            for (int axis = 0; axis < 3; ++axis) {
+                box.low[axis] = std::min(box.low[axis], part.low[axis]);
+                box.high[axis] = std::max(box.high[axis], part.high[axis]);
+            }
+            box.finite += part.finite;
+        });
         finite = box.finite;
         if (finite > 0) {
             for (int axis = 0; axis < 3; ++axis) {
@@ -739,6 +782,8 @@ bool PlyReader::readFastLayout(const SourceNormalizer& normalizer, BatchSink& si
                 outputs.positions = batch.positions.data() + slot;
                 outputs.normals = layout.hasNormals ? batch.normals.data() + slot : nullptr;
                 outputs.colors = layout.hasColors ? batch.colors.data() + slot : nullptr;
+                outputs.intensities =
+                    layout.hasIntensity ? batch.intensities.data() + slot : nullptr;
                 const std::uint8_t* first = records + done * layout.recordBytes;
                 const std::size_t converted =
                     convertFloatRecords(first, take, layout, transform, outputs);

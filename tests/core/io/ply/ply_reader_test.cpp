@@ -585,6 +585,64 @@ TEST(PlyReaderLayout, NonAdjacentFloatPositionsTakeTheScalarPath) {
     }
 }
 
+// A ushort intensity, beside float positions and uchar colours, is read by the fast loops (and
+// the bounds by the parallel pre-pass, over several 1 MiB blocks) exactly as the general code
+// reads it from the same values big-endian; with adjacent x y z (SSE2) and apart (scalar).
+TEST(PlyReaderLayout, UshortIntensityOnTheFastPathAgreesWithTheGeneralOne) {
+    struct Layout {
+        const char* name;
+        std::string properties;
+    };
+    const Layout layouts[] = {
+        {"adjacent", "property float x\nproperty float y\nproperty float z\n"
+                     "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                     "property ushort intensity\nproperty float scalar_other\n"},
+        {"apart", "property ushort intensity\nproperty float z\nproperty uchar red\n"
+                  "property float x\nproperty uchar green\nproperty uchar blue\n"
+                  "property float y\nproperty float scalar_other\n"},
+    };
+    constexpr std::size_t kPoints = 250'000; // 21-byte records: 5 MB, five pre-pass blocks
+    for (const Layout& layout : layouts) {
+        SCOPED_TRACE(layout.name);
+        test::TempDir dir;
+        PlyBytes little(binaryHeader(kPoints, layout.properties, "binary_little_endian"));
+        PlyBytes big(binaryHeader(kPoints, layout.properties, "binary_big_endian"), true);
+        const bool apart = std::string(layout.name) == "apart";
+        for (std::size_t i = 0; i < kPoints; ++i) {
+            // A NaN point now and then: skipped and counted by both paths.
+            const float x = i % 9973 == 5 ? std::numeric_limits<float>::quiet_NaN()
+                                          : 1000.0f + 0.37f * static_cast<float>(i % 5000);
+            const float y = -20.0f + 0.011f * static_cast<float>(i);
+            const float z = 3.0f * std::sin(0.001f * static_cast<float>(i));
+            const auto intensity = static_cast<std::uint16_t>((i * 7919) % 65536);
+            const auto rgb = glm::u8vec3(i % 256, (i / 256) % 256, (3 * i) % 256);
+            for (PlyBytes* bytes : {&little, &big}) {
+                if (apart) {
+                    bytes->put(intensity).put(z).put(rgb.r).put(x).put(rgb.g).put(rgb.b).put(y);
+                } else {
+                    bytes->put(x).put(y).put(z).put(rgb.r).put(rgb.g).put(rgb.b).put(intensity);
+                }
+                bytes->put(float(i));
+            }
+        }
+        little.write(dir.file("le.ply"));
+        big.write(dir.file("be.ply"));
+        const ReadResult fast = readAll(dir.file("le.ply"));
+        const ReadResult general = readAll(dir.file("be.ply"));
+        ASSERT_TRUE(fast.info.attributes.has(Attribute::Intensity));
+        EXPECT_EQ(fast.summary.skippedNonFinite, 26u); // i = 5, 9978, ... below 250,000
+        EXPECT_EQ(fast.summary.skippedNonFinite, general.summary.skippedNonFinite);
+        EXPECT_EQ(fast.info.sourceBounds, general.info.sourceBounds);
+        EXPECT_EQ(fast.points.positions, general.points.positions);
+        EXPECT_EQ(fast.points.colors, general.points.colors);
+        EXPECT_EQ(fast.points.intensities, general.points.intensities);
+        ASSERT_EQ(fast.points.intensities.size(), kPoints - 26);
+        EXPECT_EQ(fast.points.intensities[0], 0);
+        EXPECT_EQ(fast.points.intensities[1], 7919);
+        EXPECT_EQ(fast.points.intensities[9], (10 * 7919) % 65536); // point 5 was skipped
+    }
+}
+
 TEST(PlyReaderLayout, CrlfHeaderAndBody) {
     test::TempDir dir;
     const std::string binaryPath = dir.file("crlf.ply");
