@@ -1,5 +1,6 @@
 #include "io/ply/ply_reader.hpp"
 
+#include "io/decimal_text.hpp"
 #include "io/file_stream.hpp"
 #include "io/input_error.hpp"
 #include "io/line_reader.hpp"
@@ -14,7 +15,6 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <tbb/enumerable_thread_specific.h>
@@ -135,14 +135,6 @@ std::string_view nextWord(const char*& cursor, const char* end) {
         ++cursor;
     }
     return {start, static_cast<std::size_t>(cursor - start)};
-}
-
-bool parseNumber(std::string_view word, double& value) {
-    if (word.size() > 1 && word.front() == '+') {
-        word.remove_prefix(1);
-    }
-    const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), value);
-    return error == std::errc() && end == word.data() + word.size();
 }
 
 bool isBlank(std::string_view line) {
@@ -523,7 +515,7 @@ template <typename OnVertex> bool PlyReader::visitAscii(OnVertex&& onVertex) {
             }
             ++found;
             double value = 0.0;
-            if (!parseNumber(word, value)) {
+            if (!parseDecimal(word, value)) {
                 malformed("value '" + std::string(word) + "' for property '" + property.name +
                           "' is not a number");
             }

@@ -24,6 +24,7 @@
 // OpenOptions::knownBounds only replaces the bounds it finds.
 #include "io/xyz/xyz_reader.hpp"
 
+#include "io/decimal_text.hpp"
 #include "io/file_stream.hpp"
 #include "io/input_error.hpp"
 #include "io/line_reader.hpp"
@@ -32,7 +33,6 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -95,24 +95,6 @@ private:
     std::size_t m_pos = 0;
     bool m_afterComma = false;
 };
-
-// The whole field must be a number; "nan" and "inf" count (non-finite points are skipped
-// later, not rejected).
-bool parseNumber(std::string_view text, double& value) {
-    const char* first = text.data();
-    const char* last = first + text.size();
-    if (first != last && *first == '+') { // from_chars rejects a leading '+'
-        ++first;
-        if (first != last && *first == '-') {
-            return false;
-        }
-    }
-    if (first == last) {
-        return false;
-    }
-    const auto [end, error] = std::from_chars(first, last, value);
-    return error == std::errc() && end == last;
-}
 
 bool isIntegerLiteral(std::string_view text) {
     if (!text.empty() && text.front() == '+') {
@@ -183,7 +165,7 @@ struct Row {
         std::string_view field;
         double value = 0.0;
         while (splitter.next(field)) {
-            if (!parseNumber(field, value) && badColumn == 0) {
+            if (!parseDecimal(field, value) && badColumn == 0) {
                 badColumn = columns + 1;
                 badText = field;
             }
