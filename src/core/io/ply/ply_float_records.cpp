@@ -1,5 +1,7 @@
 #include "io/ply/ply_float_records.hpp"
 
+#include "io/ply/ply_values.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -122,10 +124,12 @@ struct AttributeCopy {
     std::uint16_t* intensities = nullptr;
 };
 
-// The optional float normal, uchar colour and ushort intensity of record r, shared by both
+// The optional float normal, uchar colour and ushort or float intensity of record r, shared by both
 // conversions. Only present arrays are indexed: arithmetic on an absent array's null pointer is
 // undefined behaviour (found by fuzz_ply under UBSan).
-template <bool kNormals, bool kColors, bool kIntensity>
+using Intensity = FloatRecordLayout::Intensity;
+
+template <bool kNormals, bool kColors, Intensity kIntensity>
 inline void copyOptionalAttributes(const std::uint8_t* record, std::size_t r,
                                    const AttributeCopy& copy) {
     if constexpr (kNormals) {
@@ -137,8 +141,10 @@ inline void copyOptionalAttributes(const std::uint8_t* record, std::size_t r,
         copy.colors[r] =
             glm::u8vec3(record[copy.colorAt[0]], record[copy.colorAt[1]], record[copy.colorAt[2]]);
     }
-    if constexpr (kIntensity) {
+    if constexpr (kIntensity == Intensity::UShort) {
         std::memcpy(&copy.intensities[r], record + copy.intensityAt, sizeof(std::uint16_t));
+    } else if constexpr (kIntensity == Intensity::Float) {
+        copy.intensities[r] = plyIntensity(loadFloat(record + copy.intensityAt));
     }
 }
 
@@ -147,7 +153,7 @@ AttributeCopy attributeCopy(const FloatRecordLayout& layout, const FloatRecordOu
             outputs.normals, outputs.colors, outputs.intensities};
 }
 
-template <bool kNormals, bool kColors, bool kIntensity>
+template <bool kNormals, bool kColors, Intensity kIntensity>
 std::size_t convertScalar(const std::uint8_t* records, std::size_t count,
                           const FloatRecordLayout& layout, const FloatUnitTransform& transform,
                           const FloatRecordOutputs& outputs) {
@@ -225,7 +231,7 @@ void extendSse2(const std::uint8_t* records, std::size_t count, const FloatRecor
     box.finite += finite;
 }
 
-template <bool kNormals, bool kColors, bool kIntensity>
+template <bool kNormals, bool kColors, Intensity kIntensity>
 std::size_t convertSse2(const std::uint8_t* records, std::size_t count,
                         const FloatRecordLayout& layout, const FloatUnitTransform& transform,
                         const FloatRecordOutputs& outputs) {
@@ -267,7 +273,7 @@ std::size_t convertSse2(const std::uint8_t* records, std::size_t count,
 
 #endif
 
-template <bool kNormals, bool kColors, bool kIntensity>
+template <bool kNormals, bool kColors, Intensity kIntensity>
 std::size_t convert(const std::uint8_t* records, std::size_t count, const FloatRecordLayout& layout,
                     const FloatUnitTransform& transform, const FloatRecordOutputs& outputs) {
 #if defined(__SSE2__)
@@ -284,9 +290,17 @@ std::size_t convertChoosingIntensity(const std::uint8_t* records, std::size_t co
                                      const FloatRecordLayout& layout,
                                      const FloatUnitTransform& transform,
                                      const FloatRecordOutputs& outputs) {
-    return layout.hasIntensity
-               ? convert<kNormals, kColors, true>(records, count, layout, transform, outputs)
-               : convert<kNormals, kColors, false>(records, count, layout, transform, outputs);
+    switch (layout.intensityType) {
+    case Intensity::UShort:
+        return convert<kNormals, kColors, Intensity::UShort>(records, count, layout, transform,
+                                                             outputs);
+    case Intensity::Float:
+        return convert<kNormals, kColors, Intensity::Float>(records, count, layout, transform,
+                                                            outputs);
+    case Intensity::None:
+        break;
+    }
+    return convert<kNormals, kColors, Intensity::None>(records, count, layout, transform, outputs);
 }
 
 } // namespace

@@ -1,7 +1,8 @@
 // Hot loops for the common binary PLY layout: native-endian float x y z, optionally float
-// normals, uchar colours and a ushort intensity, no lists. Both loops do only loads, a few compares
-// and the SourceNormalizer arithmetic, with an SSE2 path when x y z are adjacent; everything
-// unusual (non-finite points, points at or outside the bounds) is left to the caller's exact code.
+// normals, uchar colours and a ushort or float intensity, no lists. Both loops do only loads, a few
+// compares and the SourceNormalizer arithmetic, with an SSE2 path when x y z are adjacent;
+// everything unusual (non-finite points, points at or outside the bounds) is left to the caller's
+// exact code.
 #pragma once
 
 #include "io/source_normalizer.hpp"
@@ -25,8 +26,10 @@ struct FloatRecordLayout {
     std::array<std::size_t, 3> normal{}; // float
     bool hasColors = false;
     std::array<std::size_t, 3> color{}; // uchar
-    bool hasIntensity = false;
-    std::size_t intensity = 0; // ushort
+    // ushort (copied), or float (rounded and clamped as plyIntensity: CloudCompare's
+    // scalar_Intensity)
+    enum class Intensity { None, UShort, Float } intensityType = Intensity::None;
+    std::size_t intensity = 0;
 
     bool adjacentPosition() const {
         return position[1] == position[0] + 4 && position[2] == position[0] + 8;

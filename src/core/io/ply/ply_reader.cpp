@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <tbb/enumerable_thread_specific.h>
@@ -42,6 +43,18 @@ struct VertexFields {
 };
 
 // The first spelling whose three names are all scalar properties of `vertex`.
+int findPropertyIgnoringCase(const PlyElement& element, std::string_view lowerCaseName) {
+    for (std::size_t index = 0; index < element.properties.size(); ++index) {
+        const std::string& name = element.properties[index].name;
+        if (std::equal(
+                name.begin(), name.end(), lowerCaseName.begin(), lowerCaseName.end(),
+                [](char a, char b) { return std::tolower(static_cast<unsigned char>(a)) == b; })) {
+            return static_cast<int>(index);
+        }
+    }
+    return -1;
+}
+
 std::array<int, 3> findTriple(const PlyElement& vertex,
                               std::initializer_list<std::array<const char*, 3>> spellings) {
     for (const std::array<const char*, 3>& names : spellings) {
@@ -179,6 +192,7 @@ private:
     void loadUsedValues(const std::uint8_t* record, double* values) const;
     bool hasType(const std::array<int, 3>& fields, PlyScalarType type) const;
     bool floatPositions() const;
+    bool intensityOnFastPath() const;
     bool fastLayout() const;
     FloatRecordLayout floatLayout() const;
     bool readFastLayout(const SourceNormalizer& normalizer, BatchSink& sink, ReadSummary& summary);
@@ -281,8 +295,10 @@ void PlyReader::resolveFields() {
     m_fields.color = findTriple(element, {{"red", "green", "blue"},
                                           {"r", "g", "b"},
                                           {"diffuse_red", "diffuse_green", "diffuse_blue"}});
-    for (const char* name : {"intensity", "scalar_intensity"}) {
-        const int index = element.findProperty(name);
+    // In any case: CloudCompare writes its scalar fields as "scalar_" and the field's name
+    // ("scalar_Intensity").
+    for (const std::string_view name : {"intensity", "scalar_intensity"}) {
+        const int index = findPropertyIgnoringCase(element, name);
         if (index >= 0 && !element.properties[index].isList) {
             m_fields.intensity = index;
             break;
@@ -633,15 +649,21 @@ bool PlyReader::floatPositions() const {
            hasType(m_fields.position, PlyScalarType::Float32);
 }
 
-// The layout of ../shared/data, most scanners and our own converter: float positions,
-// optionally float normals, uchar colours and a ushort intensity (other intensity types need
-// plyIntensity's rounding and clamping).
+// The layout of ../shared/data, most scanners, CloudCompare and our own converter: float
+// positions, optionally float normals, uchar colours and a ushort or float intensity.
+bool PlyReader::intensityOnFastPath() const {
+    if (!m_fields.hasIntensity()) {
+        return true;
+    }
+    const PlyScalarType type = vertex().properties[m_fields.intensity].type;
+    return type == PlyScalarType::UInt16 || type == PlyScalarType::Float32;
+}
+
 bool PlyReader::fastLayout() const {
     return floatPositions() &&
            (!m_fields.hasNormals() || hasType(m_fields.normal, PlyScalarType::Float32)) &&
            (!m_fields.hasColors() || hasType(m_fields.color, PlyScalarType::UInt8)) &&
-           (!m_fields.hasIntensity() ||
-            vertex().properties[m_fields.intensity].type == PlyScalarType::UInt16);
+           intensityOnFastPath();
 }
 
 FloatRecordLayout PlyReader::floatLayout() const {
@@ -658,8 +680,10 @@ FloatRecordLayout PlyReader::floatLayout() const {
     }
     layout.hasNormals = m_fields.hasNormals();
     layout.hasColors = m_fields.hasColors();
-    layout.hasIntensity = m_fields.hasIntensity();
-    if (layout.hasIntensity) {
+    if (m_fields.hasIntensity()) {
+        layout.intensityType = vertex().properties[m_fields.intensity].type == PlyScalarType::UInt16
+                                   ? FloatRecordLayout::Intensity::UShort
+                                   : FloatRecordLayout::Intensity::Float;
         layout.intensity = m_propertyOffsets[m_fields.intensity];
     }
     return layout;
@@ -775,7 +799,7 @@ bool PlyReader::readFastLayout(const SourceNormalizer& normalizer, BatchSink& si
                 outputs.normals = layout.hasNormals ? batch.normals.data() + slot : nullptr;
                 outputs.colors = layout.hasColors ? batch.colors.data() + slot : nullptr;
                 outputs.intensities =
-                    layout.hasIntensity ? batch.intensities.data() + slot : nullptr;
+                    m_fields.hasIntensity() ? batch.intensities.data() + slot : nullptr;
                 const std::uint8_t* first = records + done * layout.recordBytes;
                 const std::size_t converted =
                     convertFloatRecords(first, take, layout, transform, outputs);

@@ -57,13 +57,6 @@ std::uint8_t plyColorChannel(double value, PlyScalarType type) {
     return scaled >= 255.0 ? 255 : static_cast<std::uint8_t>(scaled + 0.5);
 }
 
-std::uint16_t plyIntensity(double value) {
-    if (!(value > 0.0)) {
-        return 0;
-    }
-    return value >= 65535.0 ? 65535 : static_cast<std::uint16_t>(value + 0.5);
-}
-
 PlyBodyCursor::PlyBodyCursor(FileStream& stream, std::uint64_t start)
     : m_stream(stream), m_buffer(kCursorBufferBytes), m_bufferOffset(start) {
     m_stream.seek(start);

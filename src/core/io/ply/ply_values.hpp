@@ -20,8 +20,14 @@ double loadPlyScalar(const std::uint8_t* bytes, PlyScalarType type, bool swapByt
 // rounded; NaN gives 0.
 std::uint8_t plyColorChannel(double value, PlyScalarType type);
 
-// 16-bit intensity, clamped and rounded; NaN gives 0.
-std::uint16_t plyIntensity(double value);
+// 16-bit intensity, clamped and rounded; NaN gives 0. Inline: the fast PLY loops call it per
+// point for a float intensity.
+inline std::uint16_t plyIntensity(double value) {
+    if (!(value > 0.0)) {
+        return 0;
+    }
+    return value >= 65535.0 ? 65535 : static_cast<std::uint16_t>(value + 0.5);
+}
 
 // Walks a binary body value by value with the file offset of every value known; skipping list
 // items beyond the buffer seeks instead of reading.

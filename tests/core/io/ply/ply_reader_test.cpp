@@ -585,29 +585,40 @@ TEST(PlyReaderLayout, NonAdjacentFloatPositionsTakeTheScalarPath) {
     }
 }
 
-// A ushort intensity, beside float positions and uchar colours, is read by the fast loops (and
-// the bounds by the parallel pre-pass, over several 1 MiB blocks) exactly as the general code
-// reads it from the same values big-endian; with adjacent x y z (SSE2) and apart (scalar).
-TEST(PlyReaderLayout, UshortIntensityOnTheFastPathAgreesWithTheGeneralOne) {
+// A ushort or float intensity (CloudCompare's "scalar_Intensity"), beside float positions and
+// uchar colours, is read by the fast loops (and the bounds by the parallel pre-pass, over
+// several 1 MiB blocks) exactly as the general code reads it from the same values big-endian;
+// with adjacent x y z (SSE2) and apart (scalar).
+TEST(PlyReaderLayout, IntensityOnTheFastPathAgreesWithTheGeneralOne) {
     struct Layout {
         const char* name;
         std::string properties;
+        bool apart;
+        bool floatIntensity;
     };
     const Layout layouts[] = {
-        {"adjacent", "property float x\nproperty float y\nproperty float z\n"
-                     "property uchar red\nproperty uchar green\nproperty uchar blue\n"
-                     "property ushort intensity\nproperty float scalar_other\n"},
-        {"apart", "property ushort intensity\nproperty float z\nproperty uchar red\n"
-                  "property float x\nproperty uchar green\nproperty uchar blue\n"
-                  "property float y\nproperty float scalar_other\n"},
+        {"adjacent",
+         "property float x\nproperty float y\nproperty float z\n"
+         "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+         "property ushort intensity\nproperty float scalar_other\n",
+         false, false},
+        {"apart",
+         "property ushort intensity\nproperty float z\nproperty uchar red\n"
+         "property float x\nproperty uchar green\nproperty uchar blue\n"
+         "property float y\nproperty float scalar_other\n",
+         true, false},
+        {"float",
+         "property float x\nproperty float y\nproperty float z\n"
+         "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+         "property float scalar_Intensity\nproperty float scalar_other\n",
+         false, true},
     };
-    constexpr std::size_t kPoints = 250'000; // 21-byte records: 5 MB, five pre-pass blocks
+    constexpr std::size_t kPoints = 250'000; // 21- or 23-byte records: five pre-pass blocks
     for (const Layout& layout : layouts) {
         SCOPED_TRACE(layout.name);
         test::TempDir dir;
         PlyBytes little(binaryHeader(kPoints, layout.properties, "binary_little_endian"));
         PlyBytes big(binaryHeader(kPoints, layout.properties, "binary_big_endian"), true);
-        const bool apart = std::string(layout.name) == "apart";
         for (std::size_t i = 0; i < kPoints; ++i) {
             // A NaN point now and then: skipped and counted by both paths.
             const float x = i % 9973 == 5 ? std::numeric_limits<float>::quiet_NaN()
@@ -615,12 +626,20 @@ TEST(PlyReaderLayout, UshortIntensityOnTheFastPathAgreesWithTheGeneralOne) {
             const float y = -20.0f + 0.011f * static_cast<float>(i);
             const float z = 3.0f * std::sin(0.001f * static_cast<float>(i));
             const auto intensity = static_cast<std::uint16_t>((i * 7919) % 65536);
+            // Fractions to round, negatives, NaN and values above 65535 to clamp.
+            const float floatIntensity = i % 101 == 3 ? std::numeric_limits<float>::quiet_NaN()
+                                                      : 0.37f * static_cast<float>(i) - 1000.0f;
             const auto rgb = glm::u8vec3(i % 256, (i / 256) % 256, (3 * i) % 256);
             for (PlyBytes* bytes : {&little, &big}) {
-                if (apart) {
+                if (layout.apart) {
                     bytes->put(intensity).put(z).put(rgb.r).put(x).put(rgb.g).put(rgb.b).put(y);
                 } else {
-                    bytes->put(x).put(y).put(z).put(rgb.r).put(rgb.g).put(rgb.b).put(intensity);
+                    bytes->put(x).put(y).put(z).put(rgb.r).put(rgb.g).put(rgb.b);
+                    if (layout.floatIntensity) {
+                        bytes->put(floatIntensity);
+                    } else {
+                        bytes->put(intensity);
+                    }
                 }
                 bytes->put(float(i));
             }
@@ -637,9 +656,17 @@ TEST(PlyReaderLayout, UshortIntensityOnTheFastPathAgreesWithTheGeneralOne) {
         EXPECT_EQ(fast.points.colors, general.points.colors);
         EXPECT_EQ(fast.points.intensities, general.points.intensities);
         ASSERT_EQ(fast.points.intensities.size(), kPoints - 26);
-        EXPECT_EQ(fast.points.intensities[0], 0);
-        EXPECT_EQ(fast.points.intensities[1], 7919);
-        EXPECT_EQ(fast.points.intensities[9], (10 * 7919) % 65536); // point 5 was skipped
+        if (layout.floatIntensity) {
+            EXPECT_EQ(fast.points.intensities[3], 0);         // NaN
+            EXPECT_EQ(fast.points.intensities[2703], 0);      // point 2704: 0.48
+            EXPECT_EQ(fast.points.intensities[2705], 1);      // point 2706: 1.22
+            EXPECT_EQ(fast.points.intensities[9000], 2330);   // point 9001: 2330.37
+            EXPECT_EQ(fast.points.intensities.back(), 65535); // 91,499.63 clamped
+        } else {
+            EXPECT_EQ(fast.points.intensities[0], 0);
+            EXPECT_EQ(fast.points.intensities[1], 7919);
+            EXPECT_EQ(fast.points.intensities[9], (10 * 7919) % 65536); // point 5 was skipped
+        }
     }
 }
 
