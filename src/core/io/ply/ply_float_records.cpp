@@ -23,6 +23,12 @@ float loadFloat(const std::uint8_t* bytes) {
     return value;
 }
 
+double loadDouble(const std::uint8_t* bytes) {
+    double value;
+    std::memcpy(&value, bytes, sizeof value);
+    return value;
+}
+
 // Floats in increasing order map to increasing integers, so a binary search can walk them.
 std::int32_t floatOrder(float value) {
     const std::int32_t bits = std::bit_cast<std::int32_t>(value);
@@ -285,22 +291,55 @@ std::size_t convert(const std::uint8_t* records, std::size_t count, const FloatR
     return convertScalar<kNormals, kColors, kIntensity>(records, count, layout, transform, outputs);
 }
 
-template <bool kNormals, bool kColors>
-std::size_t convertChoosingIntensity(const std::uint8_t* records, std::size_t count,
-                                     const FloatRecordLayout& layout,
-                                     const FloatUnitTransform& transform,
-                                     const FloatRecordOutputs& outputs) {
-    switch (layout.intensityType) {
-    case Intensity::UShort:
-        return convert<kNormals, kColors, Intensity::UShort>(records, count, layout, transform,
-                                                             outputs);
-    case Intensity::Float:
-        return convert<kNormals, kColors, Intensity::Float>(records, count, layout, transform,
-                                                            outputs);
-    case Intensity::None:
-        break;
+// Double x y z, as PDAL writes them: source = x + offset and the normalizer's own checks,
+// point by point, as the general path does (no float prefilter box to find).
+template <bool kNormals, bool kColors, Intensity kIntensity>
+std::size_t convertDoubles(const std::uint8_t* records, std::size_t count,
+                           const FloatRecordLayout& layout, const SourceNormalizer& normalizer,
+                           const glm::dvec3& offset, const FloatRecordOutputs& outputs) {
+    const std::size_t stride = layout.recordBytes;
+    const std::array<std::size_t, 3> positionAt = layout.position;
+    const AttributeCopy copy = attributeCopy(layout, outputs);
+    glm::vec3* const positions = outputs.positions;
+    for (std::size_t r = 0; r < count; ++r) {
+        const std::uint8_t* record = records + r * stride;
+        const glm::dvec3 source(loadDouble(record + positionAt[0]) + offset.x,
+                                loadDouble(record + positionAt[1]) + offset.y,
+                                loadDouble(record + positionAt[2]) + offset.z);
+        if (!normalizer.inBounds(source)) { // also false for NaN
+            return r;
+        }
+        positions[r] = normalizer.toUnit(source);
+        copyOptionalAttributes<kNormals, kColors, kIntensity>(record, r, copy);
     }
-    return convert<kNormals, kColors, Intensity::None>(records, count, layout, transform, outputs);
+    return count;
+}
+
+// Calls convert.template operator()<kNormals, kColors, kIntensity>() for the layout's
+// optional attributes: one instantiation of a conversion loop per combination.
+template <typename Convert>
+std::size_t forLayoutAttributes(const FloatRecordLayout& layout, const Convert& convert) {
+    const auto withIntensity = [&]<bool kNormals, bool kColors>() -> std::size_t {
+        switch (layout.intensityType) {
+        case Intensity::UShort:
+            return convert.template operator()<kNormals, kColors, Intensity::UShort>();
+        case Intensity::Float:
+            return convert.template operator()<kNormals, kColors, Intensity::Float>();
+        case Intensity::None:
+            break;
+        }
+        return convert.template operator()<kNormals, kColors, Intensity::None>();
+    };
+    if (layout.hasNormals && layout.hasColors) {
+        return withIntensity.template operator()<true, true>();
+    }
+    if (layout.hasNormals) {
+        return withIntensity.template operator()<true, false>();
+    }
+    if (layout.hasColors) {
+        return withIntensity.template operator()<false, true>();
+    }
+    return withIntensity.template operator()<false, false>();
 }
 
 } // namespace
@@ -320,16 +359,38 @@ std::size_t convertFloatRecords(const std::uint8_t* records, std::size_t count,
                                 const FloatRecordLayout& layout,
                                 const FloatUnitTransform& transform,
                                 const FloatRecordOutputs& outputs) {
-    if (layout.hasNormals && layout.hasColors) {
-        return convertChoosingIntensity<true, true>(records, count, layout, transform, outputs);
+    return forLayoutAttributes(layout, [&]<bool kNormals, bool kColors, Intensity kIntensity>() {
+        return convert<kNormals, kColors, kIntensity>(records, count, layout, transform, outputs);
+    });
+}
+
+void extendDoubleBounds(const std::uint8_t* records, std::size_t count,
+                        const FloatRecordLayout& layout, const glm::dvec3& offset,
+                        DoubleBounds& bounds) {
+    Bounds box = bounds.box;
+    std::uint64_t finite = 0;
+    for (std::size_t r = 0; r < count; ++r) {
+        const std::uint8_t* record = records + r * layout.recordBytes;
+        const glm::dvec3 source(loadDouble(record + layout.position[0]) + offset.x,
+                                loadDouble(record + layout.position[1]) + offset.y,
+                                loadDouble(record + layout.position[2]) + offset.z);
+        if (SourceNormalizer::isFinite(source)) {
+            ++finite;
+            box.extend(source);
+        }
     }
-    if (layout.hasNormals) {
-        return convertChoosingIntensity<true, false>(records, count, layout, transform, outputs);
-    }
-    if (layout.hasColors) {
-        return convertChoosingIntensity<false, true>(records, count, layout, transform, outputs);
-    }
-    return convertChoosingIntensity<false, false>(records, count, layout, transform, outputs);
+    bounds.box = box;
+    bounds.finite += finite;
+}
+
+std::size_t convertDoubleRecords(const std::uint8_t* records, std::size_t count,
+                                 const FloatRecordLayout& layout,
+                                 const SourceNormalizer& normalizer, const glm::dvec3& offset,
+                                 const FloatRecordOutputs& outputs) {
+    return forLayoutAttributes(layout, [&]<bool kNormals, bool kColors, Intensity kIntensity>() {
+        return convertDoubles<kNormals, kColors, kIntensity>(records, count, layout, normalizer,
+                                                             offset, outputs);
+    });
 }
 
 } // namespace omicron

@@ -1,6 +1,6 @@
-// Hot loops for the common binary PLY layout: native-endian float x y z, optionally float
-// normals, uchar colours and a ushort or float intensity, no lists. Both loops do only loads, a few
-// compares and the SourceNormalizer arithmetic, with an SSE2 path when x y z are adjacent;
+// Hot loops for the common binary PLY layout: native-endian float (or double) x y z, optionally
+// float normals, uchar colours and a ushort or float intensity, no lists. Both loops do only loads,
+// a few compares and the SourceNormalizer arithmetic, with an SSE2 path when x y z are adjacent;
 // everything unusual (non-finite points, points at or outside the bounds) is left to the caller's
 // exact code.
 #pragma once
@@ -21,7 +21,8 @@ constexpr std::size_t kFloatRecordPadding = 16;
 
 struct FloatRecordLayout {
     std::size_t recordBytes = 0;
-    std::array<std::size_t, 3> position{}; // byte offsets of x y z (float)
+    std::array<std::size_t, 3> position{}; // byte offsets of x y z (float, or double below)
+    bool doublePositions = false;          // the double loops: extendDoubleBounds, convertDouble…
     bool hasNormals = false;
     std::array<std::size_t, 3> normal{}; // float
     bool hasColors = false;
@@ -31,8 +32,8 @@ struct FloatRecordLayout {
     enum class Intensity { None, UShort, Float } intensityType = Intensity::None;
     std::size_t intensity = 0;
 
-    bool adjacentPosition() const {
-        return position[1] == position[0] + 4 && position[2] == position[0] + 8;
+    bool adjacentPosition() const { // float x y z side by side: the SSE2 loops
+        return !doublePositions && position[1] == position[0] + 4 && position[2] == position[0] + 8;
     }
 };
 
@@ -73,6 +74,22 @@ struct FloatRecordOutputs {
     glm::u8vec3* colors = nullptr; // when the layout has colours
     std::uint16_t* intensities = nullptr; // when the layout has an intensity
 };
+
+// The bounds of the finite source positions (stored double + offset) of `count` records with
+// double x y z, and how many there are.
+struct DoubleBounds {
+    Bounds box;
+    std::uint64_t finite = 0;
+};
+void extendDoubleBounds(const std::uint8_t* records, std::size_t count,
+                        const FloatRecordLayout& layout, const glm::dvec3& offset,
+                        DoubleBounds& bounds);
+
+// convertFloatRecords for double x y z: each position is checked with the normalizer itself.
+std::size_t convertDoubleRecords(const std::uint8_t* records, std::size_t count,
+                                 const FloatRecordLayout& layout,
+                                 const SourceNormalizer& normalizer, const glm::dvec3& offset,
+                                 const FloatRecordOutputs& outputs);
 
 // Converts records in order while each lies inside the transform's box, writing position i
 // as float(((double(x) + offset) - origin) * inverseEdge), exactly SourceNormalizer::toUnit,

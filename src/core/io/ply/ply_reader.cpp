@@ -18,6 +18,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <tbb/enumerable_thread_specific.h>
 
 namespace omicron {
@@ -191,7 +192,7 @@ private:
     template <typename OnVertex> bool visitVertexValues(OnVertex&& onVertex);
     void loadUsedValues(const std::uint8_t* record, double* values) const;
     bool hasType(const std::array<int, 3>& fields, PlyScalarType type) const;
-    bool floatPositions() const;
+    bool fastPositions() const;
     bool intensityOnFastPath() const;
     bool fastLayout() const;
     FloatRecordLayout floatLayout() const;
@@ -642,15 +643,14 @@ bool PlyReader::hasType(const std::array<int, 3>& fields, PlyScalarType type) co
                        [&](int p) { return vertex().properties[p].type == type; });
 }
 
-// Fixed-size native-endian records with float x y z: enough for the bounds pre-pass's loop,
-// whatever the other properties are.
-bool PlyReader::floatPositions() const {
+// Fixed-size native-endian records with float or double x y z: enough for the bounds
+// pre-pass's loops, whatever the other properties are.
+bool PlyReader::fastPositions() const {
     return binary() && m_fixedRecords && !m_swapBytes &&
-           hasType(m_fields.position, PlyScalarType::Float32);
+           (hasType(m_fields.position, PlyScalarType::Float32) ||
+            hasType(m_fields.position, PlyScalarType::Float64));
 }
 
-// The layout of ../shared/data, most scanners, CloudCompare and our own converter: float
-// positions, optionally float normals, uchar colours and a ushort or float intensity.
 bool PlyReader::intensityOnFastPath() const {
     if (!m_fields.hasIntensity()) {
         return true;
@@ -659,8 +659,11 @@ bool PlyReader::intensityOnFastPath() const {
     return type == PlyScalarType::UInt16 || type == PlyScalarType::Float32;
 }
 
+// The layout of ../shared/data, most scanners, CloudCompare, PDAL (double positions) and our
+// own converter: float or double positions, optionally float normals, uchar colours and a
+// ushort or float intensity.
 bool PlyReader::fastLayout() const {
-    return floatPositions() &&
+    return fastPositions() &&
            (!m_fields.hasNormals() || hasType(m_fields.normal, PlyScalarType::Float32)) &&
            (!m_fields.hasColors() || hasType(m_fields.color, PlyScalarType::UInt8)) &&
            intensityOnFastPath();
@@ -669,6 +672,7 @@ bool PlyReader::fastLayout() const {
 FloatRecordLayout PlyReader::floatLayout() const {
     FloatRecordLayout layout;
     layout.recordBytes = static_cast<std::size_t>(m_recordBytes);
+    layout.doublePositions = hasType(m_fields.position, PlyScalarType::Float64);
     for (int axis = 0; axis < 3; ++axis) {
         layout.position[axis] = m_propertyOffsets[m_fields.position[axis]];
         if (m_fields.hasNormals()) {
@@ -694,11 +698,12 @@ void PlyReader::runBoundsPrePass(const OpenOptions& options) {
     std::uint64_t finite = 0;
     PrePassMonitor monitor(options, m_stream.path(), m_stream.size(), m_info.pointCount);
     monitor.advance(m_vertexStart);
-    if (floatPositions()) {
+    if (fastPositions()) {
         // Min/max of the stored floats, offset added once at the end: double(x) + offset is
-        // monotonic in x, so this equals the per-point bounds read() checks against. The blocks
-        // are read and scanned on every core (a scan is mostly the kernel's copy); each thread
-        // keeps its own box, and the sample and the progress go on in file order.
+        // monotonic in x, so this equals the per-point bounds read() checks against (double
+        // positions: of x + offset, as the general path). The blocks are read and scanned on
+        // every core (a scan is mostly the kernel's copy); each thread keeps its own box, and
+        // the sample and the progress go on in file order.
         const FloatRecordLayout layout = floatLayout();
         const RecordArray array{m_vertexStart, m_recordBytes, vertex().count};
         const bool sampling = monitor.samples(0);
@@ -706,11 +711,28 @@ void PlyReader::runBoundsPrePass(const OpenOptions& options) {
         std::vector<std::vector<glm::dvec3>> blockSamples(
             sampling ? static_cast<std::size_t>(recordBlockCount(array, kBlockBytes)) : 0);
         tbb::enumerable_thread_specific<FloatBox> boxes;
+        tbb::enumerable_thread_specific<DoubleBounds> doubleBounds;
+        const auto stored = [&](const std::uint8_t* record, int axis) {
+            const std::uint8_t* at = record + layout.position[axis];
+            if (layout.doublePositions) {
+                double value;
+                std::memcpy(&value, at, sizeof value);
+                return value;
+            }
+            float value;
+            std::memcpy(&value, at, sizeof value);
+            return double(value);
+        };
         scanRecordsInParallel(
             m_stream, array, kBlockBytes, kFloatRecordPadding,
             [&](const std::uint8_t* records, std::size_t count, std::uint64_t firstIndex,
                 std::uint64_t block) {
-                extendFloatBox(records, count, layout, boxes.local());
+                if (layout.doublePositions) {
+                    extendDoubleBounds(records, count, layout, m_header.offset,
+                                       doubleBounds.local());
+                } else {
+                    extendFloatBox(records, count, layout, boxes.local());
+                }
                 if (!sampling) {
                     return;
                 }
@@ -720,9 +742,7 @@ void PlyReader::runBoundsPrePass(const OpenOptions& options) {
                     const std::uint8_t* record = records + (i - firstIndex) * m_recordBytes;
                     glm::dvec3 source;
                     for (int axis = 0; axis < 3; ++axis) {
-                        float value;
-                        std::memcpy(&value, record + layout.position[axis], sizeof value);
-                        source[axis] = double(value) + m_header.offset[axis];
+                        source[axis] = stored(record, axis) + m_header.offset[axis];
                     }
                     if (SourceNormalizer::isFinite(source)) {
                         samples.push_back(source);
@@ -754,6 +774,10 @@ void PlyReader::runBoundsPrePass(const OpenOptions& options) {
                 bounds.max[axis] = static_cast<double>(box.high[axis]) + m_header.offset[axis];
             }
         }
+        doubleBounds.combine_each([&](const DoubleBounds& part) {
+            bounds.extend(part.box);
+            finite += part.finite;
+        });
     } else {
         visitVertexValues([&](const double* values, std::uint64_t index,
                               std::uint64_t byteOrLine) {
@@ -784,8 +808,10 @@ void PlyReader::runBoundsPrePass(const OpenOptions& options) {
 bool PlyReader::readFastLayout(const SourceNormalizer& normalizer, BatchSink& sink,
                                ReadSummary& summary) {
     const FloatRecordLayout layout = floatLayout();
-    const FloatUnitTransform transform(normalizer, m_info.cube, m_info.sourceBounds,
-                                       m_header.offset);
+    std::optional<FloatUnitTransform> transform; // float positions' prefilter
+    if (!layout.doublePositions) {
+        transform.emplace(normalizer, m_info.cube, m_info.sourceBounds, m_header.offset);
+    }
     std::vector<double> values(vertex().properties.size(), 0.0);
     return visitFixedBlocks(
         [&](const std::uint8_t* records, std::size_t count, std::uint64_t firstIndex) {
@@ -802,7 +828,9 @@ bool PlyReader::readFastLayout(const SourceNormalizer& normalizer, BatchSink& si
                     m_fields.hasIntensity() ? batch.intensities.data() + slot : nullptr;
                 const std::uint8_t* first = records + done * layout.recordBytes;
                 const std::size_t converted =
-                    convertFloatRecords(first, take, layout, transform, outputs);
+                    transform ? convertFloatRecords(first, take, layout, *transform, outputs)
+                              : convertDoubleRecords(first, take, layout, normalizer,
+                                                     m_header.offset, outputs);
                 done += converted;
                 if (!sink.commit(converted)) {
                     return false;

@@ -670,6 +670,53 @@ TEST(PlyReaderLayout, IntensityOnTheFastPathAgreesWithTheGeneralOne) {
     }
 }
 
+// Double x y z (PDAL's PLY writer), with a "comment offset", float normals, uchar colours and
+// a ushort intensity: the double loops and the parallel pre-pass give what the general code
+// gives from the same values big-endian, bit for bit, NaN points skipped and counted alike.
+TEST(PlyReaderLayout, DoublePositionsOnTheFastPathAgreeWithTheGeneralOne) {
+    const std::string properties =
+        "property double x\nproperty double y\nproperty double z\nproperty float nx\n"
+        "property float ny\nproperty float nz\nproperty uchar red\nproperty uchar green\n"
+        "property uchar blue\nproperty ushort intensity\n";
+    const auto header = [&](const char* format) {
+        return "ply\nformat " + std::string(format) +
+               " 1.0\ncomment offset 635000 848000 0\nelement vertex 150000\n" + properties +
+               "end_header\n";
+    };
+    constexpr std::size_t kPoints = 150'000; // 45-byte records: 6.75 MB, seven pre-pass blocks
+    test::TempDir dir;
+    PlyBytes little(header("binary_little_endian"));
+    PlyBytes big(header("binary_big_endian"), true);
+    for (std::size_t i = 0; i < kPoints; ++i) {
+        const double x = i % 7919 == 11 ? std::numeric_limits<double>::infinity()
+                                        : 577.123456789 + 0.0731 * static_cast<double>(i % 40000);
+        const double y = 882.5 + 1e-7 * static_cast<double>(i * i % 1000003);
+        const double z = 406.25 + std::sin(1e-4 * static_cast<double>(i));
+        const glm::vec3 normal(0.0f, 0.6f, i % 2 == 0 ? 0.8f : -0.8f);
+        for (PlyBytes* bytes : {&little, &big}) {
+            bytes->put(x).put(y).put(z).put(normal.x).put(normal.y).put(normal.z);
+            bytes->put(std::uint8_t(i % 251)).put(std::uint8_t(i % 13)).put(std::uint8_t(7));
+            bytes->put(static_cast<std::uint16_t>(i % 60000));
+        }
+    }
+    little.write(dir.file("le.ply"));
+    big.write(dir.file("be.ply"));
+    const ReadResult fast = readAll(dir.file("le.ply"));
+    const ReadResult general = readAll(dir.file("be.ply"));
+    EXPECT_EQ(fast.summary.skippedNonFinite, 19u); // i = 11, 7930, ... below 150,000
+    EXPECT_EQ(fast.summary.skippedNonFinite, general.summary.skippedNonFinite);
+    EXPECT_EQ(fast.info.sourceBounds, general.info.sourceBounds);
+    EXPECT_EQ(fast.info.cube, general.info.cube);
+    EXPECT_EQ(fast.points.positions, general.points.positions);
+    EXPECT_EQ(fast.points.normals, general.points.normals);
+    EXPECT_EQ(fast.points.colors, general.points.colors);
+    EXPECT_EQ(fast.points.intensities, general.points.intensities);
+    ASSERT_EQ(fast.points.size(), kPoints - 19);
+    EXPECT_DOUBLE_EQ(fast.info.sourceBounds.min.x, 635577.123456789);
+    expectNear(sourceOf(fast, 1), {635577.123456789 + 0.0731, 848882.5 + 1e-7, 406.25 + 1e-4},
+               unitTolerance(fast));
+}
+
 TEST(PlyReaderLayout, CrlfHeaderAndBody) {
     test::TempDir dir;
     const std::string binaryPath = dir.file("crlf.ply");
