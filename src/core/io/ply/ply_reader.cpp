@@ -43,7 +43,6 @@ struct VertexFields {
     bool hasIntensity() const { return intensity >= 0; }
 };
 
-// The first spelling whose three names are all scalar properties of `vertex`.
 int findPropertyIgnoringCase(const PlyElement& element, std::string_view lowerCaseName) {
     for (std::size_t index = 0; index < element.properties.size(); ++index) {
         const std::string& name = element.properties[index].name;
@@ -56,6 +55,7 @@ int findPropertyIgnoringCase(const PlyElement& element, std::string_view lowerCa
     return -1;
 }
 
+// The first spelling whose three names are all scalar properties of `vertex`.
 std::array<int, 3> findTriple(const PlyElement& vertex,
                               std::initializer_list<std::array<const char*, 3>> spellings) {
     for (const std::array<const char*, 3>& names : spellings) {
@@ -196,6 +196,7 @@ private:
     bool intensityOnFastPath() const;
     bool fastLayout() const;
     FloatRecordLayout floatLayout() const;
+    void scanFixedRecordBounds(PrePassMonitor& monitor, Bounds& bounds, std::uint64_t& finite);
     bool readFastLayout(const SourceNormalizer& normalizer, BatchSink& sink, ReadSummary& summary);
     bool addVertex(const double* values, const SourceNormalizer& normalizer, BatchSink& sink,
                    ReadSummary& summary, InputLocation where) const;
@@ -693,91 +694,95 @@ FloatRecordLayout PlyReader::floatLayout() const {
     return layout;
 }
 
+// The pre-pass of fixed native-endian records with float or double positions: min/max of the
+// stored floats, offset added once at the end: double(x) + offset is monotonic in x, so this
+// equals the per-point bounds read() checks against (double positions: of x + offset, as the
+// general path). The blocks are read and scanned on every core (a scan is mostly the kernel's
+// copy); each thread keeps its own box, and the sample and the progress go on in file order.
+void PlyReader::scanFixedRecordBounds(PrePassMonitor& monitor, Bounds& bounds,
+                                      std::uint64_t& finite) {
+    const FloatRecordLayout layout = floatLayout();
+    const RecordArray array{m_vertexStart, m_recordBytes, vertex().count};
+    const bool sampling = monitor.samples(0);
+    const std::uint64_t stride = monitor.sampleStride();
+    std::vector<std::vector<glm::dvec3>> blockSamples(
+        sampling ? static_cast<std::size_t>(recordBlockCount(array, kBlockBytes)) : 0);
+    tbb::enumerable_thread_specific<FloatBox> boxes;
+    tbb::enumerable_thread_specific<DoubleBounds> doubleBounds;
+    const auto stored = [&](const std::uint8_t* record, int axis) {
+        const std::uint8_t* at = record + layout.position[axis];
+        if (layout.doublePositions) {
+            double value;
+            std::memcpy(&value, at, sizeof value);
+            return value;
+        }
+        float value;
+        std::memcpy(&value, at, sizeof value);
+        return double(value);
+    };
+    scanRecordsInParallel(
+        m_stream, array, kBlockBytes, kFloatRecordPadding,
+        [&](const std::uint8_t* records, std::size_t count, std::uint64_t firstIndex,
+            std::uint64_t block) {
+            if (layout.doublePositions) {
+                extendDoubleBounds(records, count, layout, m_header.offset, doubleBounds.local());
+            } else {
+                extendFloatBox(records, count, layout, boxes.local());
+            }
+            if (!sampling) {
+                return;
+            }
+            std::vector<glm::dvec3>& samples = blockSamples[static_cast<std::size_t>(block)];
+            for (std::uint64_t i = (firstIndex + stride - 1) / stride * stride;
+                 i < firstIndex + count; i += stride) {
+                const std::uint8_t* record = records + (i - firstIndex) * m_recordBytes;
+                glm::dvec3 source;
+                for (int axis = 0; axis < 3; ++axis) {
+                    source[axis] = stored(record, axis) + m_header.offset[axis];
+                }
+                if (SourceNormalizer::isFinite(source)) {
+                    samples.push_back(source);
+                }
+            }
+        },
+        [&](std::uint64_t block, std::uint64_t endByte) {
+            if (sampling) {
+                std::vector<glm::dvec3> samples;
+                std::swap(samples, blockSamples[static_cast<std::size_t>(block)]);
+                for (const glm::dvec3& source : samples) {
+                    monitor.offer(source);
+                }
+            }
+            return monitor.reached(endByte);
+        });
+    FloatBox box;
+    boxes.combine_each([&](const FloatBox& part) {
+        for (int axis = 0; axis < 3; ++axis) {
+            box.low[axis] = std::min(box.low[axis], part.low[axis]);
+            box.high[axis] = std::max(box.high[axis], part.high[axis]);
+        }
+        box.finite += part.finite;
+    });
+    finite = box.finite;
+    if (finite > 0) {
+        for (int axis = 0; axis < 3; ++axis) {
+            bounds.min[axis] = static_cast<double>(box.low[axis]) + m_header.offset[axis];
+            bounds.max[axis] = static_cast<double>(box.high[axis]) + m_header.offset[axis];
+        }
+    }
+    doubleBounds.combine_each([&](const DoubleBounds& part) {
+        bounds.extend(part.box);
+        finite += part.finite;
+    });
+}
+
 void PlyReader::runBoundsPrePass(const OpenOptions& options) {
     Bounds bounds;
     std::uint64_t finite = 0;
     PrePassMonitor monitor(options, m_stream.path(), m_stream.size(), m_info.pointCount);
     monitor.advance(m_vertexStart);
     if (fastPositions()) {
-        // Min/max of the stored floats, offset added once at the end: double(x) + offset is
-        // monotonic in x, so this equals the per-point bounds read() checks against (double
-        // positions: of x + offset, as the general path). The blocks are read and scanned on
-        // every core (a scan is mostly the kernel's copy); each thread keeps its own box, and
-        // the sample and the progress go on in file order.
-        const FloatRecordLayout layout = floatLayout();
-        const RecordArray array{m_vertexStart, m_recordBytes, vertex().count};
-        const bool sampling = monitor.samples(0);
-        const std::uint64_t stride = monitor.sampleStride();
-        std::vector<std::vector<glm::dvec3>> blockSamples(
-            sampling ? static_cast<std::size_t>(recordBlockCount(array, kBlockBytes)) : 0);
-        tbb::enumerable_thread_specific<FloatBox> boxes;
-        tbb::enumerable_thread_specific<DoubleBounds> doubleBounds;
-        const auto stored = [&](const std::uint8_t* record, int axis) {
-            const std::uint8_t* at = record + layout.position[axis];
-            if (layout.doublePositions) {
-                double value;
-                std::memcpy(&value, at, sizeof value);
-                return value;
-            }
-            float value;
-            std::memcpy(&value, at, sizeof value);
-            return double(value);
-        };
-        scanRecordsInParallel(
-            m_stream, array, kBlockBytes, kFloatRecordPadding,
-            [&](const std::uint8_t* records, std::size_t count, std::uint64_t firstIndex,
-                std::uint64_t block) {
-                if (layout.doublePositions) {
-                    extendDoubleBounds(records, count, layout, m_header.offset,
-                                       doubleBounds.local());
-                } else {
-                    extendFloatBox(records, count, layout, boxes.local());
-                }
-                if (!sampling) {
-                    return;
-                }
-                std::vector<glm::dvec3>& samples = blockSamples[static_cast<std::size_t>(block)];
-                for (std::uint64_t i = (firstIndex + stride - 1) / stride * stride;
-                     i < firstIndex + count; i += stride) {
-                    const std::uint8_t* record = records + (i - firstIndex) * m_recordBytes;
-                    glm::dvec3 source;
-                    for (int axis = 0; axis < 3; ++axis) {
-                        source[axis] = stored(record, axis) + m_header.offset[axis];
-                    }
-                    if (SourceNormalizer::isFinite(source)) {
-                        samples.push_back(source);
-                    }
-                }
-            },
-            [&](std::uint64_t block, std::uint64_t endByte) {
-                if (sampling) {
-                    std::vector<glm::dvec3> samples;
-                    std::swap(samples, blockSamples[static_cast<std::size_t>(block)]);
-                    for (const glm::dvec3& source : samples) {
-                        monitor.offer(source);
-                    }
-                }
-                return monitor.reached(endByte);
-            });
-        FloatBox box;
-        boxes.combine_each([&](const FloatBox& part) {
-            for (int axis = 0; axis < 3; ++axis) {
-                box.low[axis] = std::min(box.low[axis], part.low[axis]);
-                box.high[axis] = std::max(box.high[axis], part.high[axis]);
-            }
-            box.finite += part.finite;
-        });
-        finite = box.finite;
-        if (finite > 0) {
-            for (int axis = 0; axis < 3; ++axis) {
-                bounds.min[axis] = static_cast<double>(box.low[axis]) + m_header.offset[axis];
-                bounds.max[axis] = static_cast<double>(box.high[axis]) + m_header.offset[axis];
-            }
-        }
-        doubleBounds.combine_each([&](const DoubleBounds& part) {
-            bounds.extend(part.box);
-            finite += part.finite;
-        });
+        scanFixedRecordBounds(monitor, bounds, finite);
     } else {
         visitVertexValues([&](const double* values, std::uint64_t index,
                               std::uint64_t byteOrLine) {
