@@ -585,6 +585,18 @@ TEST(PlyReaderLayout, NonAdjacentFloatPositionsTakeTheScalarPath) {
     }
 }
 
+// The fast loops' read of a file against the general code's read of the same values: the
+// same bounds, cube, skipped points and attributes, bit for bit.
+void expectTheSameRead(const ReadResult& fast, const ReadResult& general) {
+    EXPECT_EQ(fast.summary.skippedNonFinite, general.summary.skippedNonFinite);
+    EXPECT_EQ(fast.info.sourceBounds, general.info.sourceBounds);
+    EXPECT_EQ(fast.info.cube, general.info.cube);
+    EXPECT_EQ(fast.points.positions, general.points.positions);
+    EXPECT_EQ(fast.points.normals, general.points.normals);
+    EXPECT_EQ(fast.points.colors, general.points.colors);
+    EXPECT_EQ(fast.points.intensities, general.points.intensities);
+}
+
 // A ushort or float intensity (CloudCompare's "scalar_Intensity"), beside float positions and
 // uchar colours, is read by the fast loops (and the bounds by the parallel pre-pass, over
 // several 1 MiB blocks) exactly as the general code reads it from the same values big-endian;
@@ -647,14 +659,9 @@ TEST(PlyReaderLayout, IntensityOnTheFastPathAgreesWithTheGeneralOne) {
         little.write(dir.file("le.ply"));
         big.write(dir.file("be.ply"));
         const ReadResult fast = readAll(dir.file("le.ply"));
-        const ReadResult general = readAll(dir.file("be.ply"));
         ASSERT_TRUE(fast.info.attributes.has(Attribute::Intensity));
         EXPECT_EQ(fast.summary.skippedNonFinite, 26u); // i = 5, 9978, ... below 250,000
-        EXPECT_EQ(fast.summary.skippedNonFinite, general.summary.skippedNonFinite);
-        EXPECT_EQ(fast.info.sourceBounds, general.info.sourceBounds);
-        EXPECT_EQ(fast.points.positions, general.points.positions);
-        EXPECT_EQ(fast.points.colors, general.points.colors);
-        EXPECT_EQ(fast.points.intensities, general.points.intensities);
+        expectTheSameRead(fast, readAll(dir.file("be.ply")));
         ASSERT_EQ(fast.points.intensities.size(), kPoints - 26);
         if (layout.floatIntensity) {
             EXPECT_EQ(fast.points.intensities[3], 0);         // NaN
@@ -702,15 +709,8 @@ TEST(PlyReaderLayout, DoublePositionsOnTheFastPathAgreeWithTheGeneralOne) {
     little.write(dir.file("le.ply"));
     big.write(dir.file("be.ply"));
     const ReadResult fast = readAll(dir.file("le.ply"));
-    const ReadResult general = readAll(dir.file("be.ply"));
     EXPECT_EQ(fast.summary.skippedNonFinite, 19u); // i = 11, 7930, ... below 150,000
-    EXPECT_EQ(fast.summary.skippedNonFinite, general.summary.skippedNonFinite);
-    EXPECT_EQ(fast.info.sourceBounds, general.info.sourceBounds);
-    EXPECT_EQ(fast.info.cube, general.info.cube);
-    EXPECT_EQ(fast.points.positions, general.points.positions);
-    EXPECT_EQ(fast.points.normals, general.points.normals);
-    EXPECT_EQ(fast.points.colors, general.points.colors);
-    EXPECT_EQ(fast.points.intensities, general.points.intensities);
+    expectTheSameRead(fast, readAll(dir.file("be.ply")));
     ASSERT_EQ(fast.points.size(), kPoints - 19);
     EXPECT_DOUBLE_EQ(fast.info.sourceBounds.min.x, 635577.123456789);
     expectNear(sourceOf(fast, 1), {635577.123456789 + 0.0731, 848882.5 + 1e-7, 406.25 + 1e-4},
