@@ -130,11 +130,11 @@ struct AttributeCopy {
     std::uint16_t* intensities = nullptr;
 };
 
+using Intensity = FloatRecordLayout::Intensity;
+
 // The optional float normal, uchar colour and ushort or float intensity of record r, shared by both
 // conversions. Only present arrays are indexed: arithmetic on an absent array's null pointer is
 // undefined behaviour (found by fuzz_ply under UBSan).
-using Intensity = FloatRecordLayout::Intensity;
-
 template <bool kNormals, bool kColors, Intensity kIntensity>
 inline void copyOptionalAttributes(const std::uint8_t* record, std::size_t r,
                                    const AttributeCopy& copy) {
@@ -364,16 +364,24 @@ std::size_t convertFloatRecords(const std::uint8_t* records, std::size_t count,
     });
 }
 
+glm::dvec3 sourcePosition(const std::uint8_t* record, const FloatRecordLayout& layout,
+                          const glm::dvec3& offset) {
+    glm::dvec3 source;
+    for (int axis = 0; axis < 3; ++axis) {
+        const std::uint8_t* stored = record + layout.position[axis];
+        source[axis] =
+            (layout.doublePositions ? loadDouble(stored) : loadFloat(stored)) + offset[axis];
+    }
+    return source;
+}
+
 void extendDoubleBounds(const std::uint8_t* records, std::size_t count,
                         const FloatRecordLayout& layout, const glm::dvec3& offset,
                         DoubleBounds& bounds) {
     Bounds box = bounds.box;
     std::uint64_t finite = 0;
     for (std::size_t r = 0; r < count; ++r) {
-        const std::uint8_t* record = records + r * layout.recordBytes;
-        const glm::dvec3 source(loadDouble(record + layout.position[0]) + offset.x,
-                                loadDouble(record + layout.position[1]) + offset.y,
-                                loadDouble(record + layout.position[2]) + offset.z);
+        const glm::dvec3 source = sourcePosition(records + r * layout.recordBytes, layout, offset);
         if (SourceNormalizer::isFinite(source)) {
             ++finite;
             box.extend(source);

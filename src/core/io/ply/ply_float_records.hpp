@@ -75,6 +75,10 @@ struct FloatRecordOutputs {
     std::uint16_t* intensities = nullptr; // when the layout has an intensity
 };
 
+// A record's source position: its stored x y z (float or double) as doubles, plus `offset`.
+glm::dvec3 sourcePosition(const std::uint8_t* record, const FloatRecordLayout& layout,
+                          const glm::dvec3& offset);
+
 // The bounds of the finite source positions (stored double + offset) of `count` records with
 // double x y z, and how many there are.
 struct DoubleBounds {

@@ -1,5 +1,6 @@
 #include "io/ply/ply_header.hpp"
 
+#include "io/decimal_text.hpp"
 #include "io/input_error.hpp"
 
 #include <algorithm>
@@ -64,12 +65,8 @@ std::vector<std::string_view> splitWords(std::string_view line) {
 }
 
 std::optional<double> parseDouble(std::string_view text) {
-    if (!text.empty() && text.front() == '+') {
-        text.remove_prefix(1);
-    }
     double value = 0.0;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (error != std::errc() || end != text.data() + text.size() || !std::isfinite(value)) {
+    if (!parseDecimal(text, value) || !std::isfinite(value)) {
         return std::nullopt;
     }
     return value;

@@ -709,17 +709,6 @@ void PlyReader::scanFixedRecordBounds(PrePassMonitor& monitor, Bounds& bounds,
         sampling ? static_cast<std::size_t>(recordBlockCount(array, kBlockBytes)) : 0);
     tbb::enumerable_thread_specific<FloatBox> boxes;
     tbb::enumerable_thread_specific<DoubleBounds> doubleBounds;
-    const auto stored = [&](const std::uint8_t* record, int axis) {
-        const std::uint8_t* at = record + layout.position[axis];
-        if (layout.doublePositions) {
-            double value;
-            std::memcpy(&value, at, sizeof value);
-            return value;
-        }
-        float value;
-        std::memcpy(&value, at, sizeof value);
-        return double(value);
-    };
     scanRecordsInParallel(
         m_stream, array, kBlockBytes, kFloatRecordPadding,
         [&](const std::uint8_t* records, std::size_t count, std::uint64_t firstIndex,
@@ -735,11 +724,8 @@ void PlyReader::scanFixedRecordBounds(PrePassMonitor& monitor, Bounds& bounds,
             std::vector<glm::dvec3>& samples = blockSamples[static_cast<std::size_t>(block)];
             for (std::uint64_t i = (firstIndex + stride - 1) / stride * stride;
                  i < firstIndex + count; i += stride) {
-                const std::uint8_t* record = records + (i - firstIndex) * m_recordBytes;
-                glm::dvec3 source;
-                for (int axis = 0; axis < 3; ++axis) {
-                    source[axis] = stored(record, axis) + m_header.offset[axis];
-                }
+                const glm::dvec3 source = sourcePosition(records + (i - firstIndex) * m_recordBytes,
+                                                         layout, m_header.offset);
                 if (SourceNormalizer::isFinite(source)) {
                     samples.push_back(source);
                 }
