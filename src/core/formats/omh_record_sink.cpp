@@ -11,9 +11,6 @@ namespace {
 
 // Point records are encoded into a block of about this size before being hashed and written.
 constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
-// A positional sink starts the write-back of each window it completes and drops the window
-// before it from the page cache (the sequential writer's drop-behind, per region).
-constexpr std::uint64_t kCacheWindowBytes = std::uint64_t{64} << 20;
 
 } // namespace
 
@@ -26,7 +23,8 @@ OmhRecordSink::OmhRecordSink(AtomicFileWriter& file, const SortedCloud& cloud,
                              const omh::RecordLayout& layout, std::uint64_t offset)
     : OmhRecordSink(file, cloud, layout) {
     m_positional = true;
-    m_regionStart = m_at = offset;
+    m_at = offset;
+    m_writeBehind = WriteBehind(offset);
 }
 
 namespace {
@@ -175,8 +173,8 @@ void OmhRecordSink::addEncoded(const std::uint8_t* records, std::size_t bytes) {
 
 std::uint64_t OmhRecordSink::finishSection() {
     flush();
-    if (m_positional && m_at > m_regionStart + m_released) {
-        m_file.startWriteBack(m_regionStart + m_released, m_at - m_regionStart - m_released);
+    if (m_positional) {
+        m_writeBehind.finish(m_file, m_at);
     }
     const std::uint64_t digest = m_checksum->digest();
     m_checksum = std::make_unique<oms::PayloadChecksum>();
@@ -199,14 +197,7 @@ void OmhRecordSink::write(const std::uint8_t* records, std::size_t bytes) {
     }
     m_file.writeAt(m_at, records, bytes);
     m_at += bytes;
-    // Two complete windows behind the write position: start the newer's write-back, wait for
-    // the older's and drop it. At most two windows of each region stay cached.
-    while (m_at - m_regionStart >= m_released + 2 * kCacheWindowBytes) {
-        const std::uint64_t older = m_regionStart + m_released;
-        m_file.startWriteBack(older + kCacheWindowBytes, kCacheWindowBytes);
-        m_file.dropFromCache(older, kCacheWindowBytes);
-        m_released += kCacheWindowBytes;
-    }
+    m_writeBehind.advance(m_file, m_at);
 }
 
 } // namespace omicron

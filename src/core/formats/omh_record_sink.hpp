@@ -9,6 +9,7 @@
 #include "formats/omh_format.hpp"
 #include "formats/oms_format.hpp"
 #include "io/atomic_file_writer.hpp"
+#include "io/write_behind.hpp"
 #include "points/sorted_cloud.hpp"
 
 #include <cstdint>
@@ -58,9 +59,8 @@ private:
     std::size_t m_used = 0;
     std::unique_ptr<oms::PayloadChecksum> m_checksum;
     bool m_positional = false;
-    std::uint64_t m_regionStart = 0; // positional: where the sink started
-    std::uint64_t m_at = 0;          // positional: where the next block goes
-    std::uint64_t m_released = 0;    // positional: bytes from m_regionStart out of the cache
+    std::uint64_t m_at = 0;    // positional: where the next block goes
+    WriteBehind m_writeBehind; // positional: what it wrote leaves the page cache
 };
 
 } // namespace omicron

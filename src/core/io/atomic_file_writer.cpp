@@ -23,7 +23,6 @@ namespace omicron {
 
 namespace {
 constexpr std::size_t kBufferBytes = 4 << 20;
-constexpr std::uint64_t kDropBehindWindow = std::uint64_t{64} << 20;
 
 // Free bytes of a tmpfs that holds `fd`, or nullopt for any other file system. A tmpfs has no
 // blocks to reserve: fallocate there allocates and zeroes the file's memory pages, serially and
@@ -108,25 +107,7 @@ void AtomicFileWriter::flushBuffer() {
     }
     m_buffered = 0;
     m_onFile += done;
-    dropBehind();
-}
-
-void AtomicFileWriter::dropBehind() {
-    // A multi-gigabyte output would otherwise fill the page cache and push out what the
-    // process reads meanwhile (the sorted points of a build beyond the memory budget are in a
-    // scratch file, read through the page cache while the .omh is written): each window's
-    // write-back is started when it is complete, and once the next one is complete too, the
-    // older is waited for and dropped from the cache. At most two windows stay cached.
-    while (m_onFile >= m_windowStart + 2 * kDropBehindWindow) {
-        const auto older = static_cast<off_t>(m_windowStart);
-        const auto window = static_cast<off_t>(kDropBehindWindow);
-        sync_file_range(m_fd, older + window, window, SYNC_FILE_RANGE_WRITE);
-        sync_file_range(m_fd, older, window,
-                        SYNC_FILE_RANGE_WAIT_BEFORE | SYNC_FILE_RANGE_WRITE |
-                            SYNC_FILE_RANGE_WAIT_AFTER);
-        posix_fadvise(m_fd, older, window, POSIX_FADV_DONTNEED);
-        m_windowStart += kDropBehindWindow;
-    }
+    m_writeBehind.advance(*this, m_onFile);
 }
 
 void AtomicFileWriter::write(const void* data, std::size_t count) {
@@ -198,7 +179,7 @@ void AtomicFileWriter::extendTo(std::uint64_t size) {
         fail("seek failed", errno);
     }
     m_onFile = m_bytesWritten = size;
-    m_windowStart = size; // the regions before it are released by their writers
+    m_writeBehind = WriteBehind(size); // the regions before it are released by their writers
 }
 
 void AtomicFileWriter::startWriteBack(std::uint64_t offset, std::uint64_t count) {

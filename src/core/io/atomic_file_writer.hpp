@@ -8,6 +8,8 @@
 // once their process is gone (leftover_files.hpp).
 #pragma once
 
+#include "io/write_behind.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <stdexcept>
@@ -47,7 +49,7 @@ public:
     void extendTo(std::uint64_t size);
 
     // For regions filled with writeAt: starts writing [offset, offset + count) back to disk,
-    // or waits for that and drops it from the page cache (see dropBehind in the .cpp).
+    // or waits for that and drops it from the page cache (io/write_behind.hpp).
     void startWriteBack(std::uint64_t offset, std::uint64_t count);
     void dropFromCache(std::uint64_t offset, std::uint64_t count);
 
@@ -59,8 +61,6 @@ public:
 
 private:
     void flushBuffer();
-    // Large files: written windows leave the page cache (see the .cpp).
-    void dropBehind();
     [[noreturn]] void fail(const std::string& what, int error);
     // Gives the nameless temporary its hidden name beside the target, for the rename.
     void nameTemporary();
@@ -73,7 +73,7 @@ private:
     std::size_t m_buffered = 0;
     std::uint64_t m_bytesWritten = 0;
     std::uint64_t m_onFile = 0;      // bytes handed to write(2)
-    std::uint64_t m_windowStart = 0; // the oldest window still in the page cache
+    WriteBehind m_writeBehind;       // large files: written windows leave the page cache
     bool m_committed = false;
 };
 
