@@ -29,6 +29,8 @@ public:
     bool samples(std::uint64_t index) const {
         return m_options.onPrePassPoints && index % m_sampleStride == 0;
     }
+    // Whether anyone takes the sample at all.
+    bool sampling() const { return static_cast<bool>(m_options.onPrePassPoints); }
     std::uint64_t sampleStride() const { return m_sampleStride; }
     void offer(const glm::dvec3& source) { m_sampled.push_back(source); }
 

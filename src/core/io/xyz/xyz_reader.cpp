@@ -21,7 +21,9 @@
 //
 // Text has no header with a count or a layout, so the pre-pass always runs (it validates the
 // whole file, counts the records and decides the colour/normal and intensity rules);
-// OpenOptions::knownBounds only replaces the bounds it finds.
+// OpenOptions::knownBounds only replaces the bounds it finds. Both passes parse blocks of
+// lines on every core and take them in file order (io/text_blocks.hpp): the same points, the
+// same first error and the same preview sample as a line-by-line read.
 #include "io/xyz/xyz_reader.hpp"
 
 #include "io/decimal_text.hpp"
@@ -30,6 +32,7 @@
 #include "io/line_reader.hpp"
 #include "io/pre_pass_monitor.hpp"
 #include "io/source_normalizer.hpp"
+#include "io/text_blocks.hpp"
 
 #include <algorithm>
 #include <array>
@@ -137,8 +140,9 @@ bool isSkippedLine(std::string_view line) {
 }
 
 // The next line that holds content: a UTF-8 byte-order mark at the start of the file is
-// dropped, comment and blank lines are skipped. False at the end of the file.
-bool nextContentLine(LineReader& lines, std::string_view& line) {
+// dropped, comment and blank lines are skipped. False at the end of the file (or block).
+// `Lines` is a LineReader or TextBlockLines.
+template <typename Lines> bool nextContentLine(Lines& lines, std::string_view& line) {
     while (lines.next(line)) {
         if (lines.lineOffset() == 0 && line.substr(0, kUtf8Bom.size()) == kUtf8Bom) {
             line.remove_prefix(kUtf8Bom.size());
@@ -277,22 +281,44 @@ void checkColors(const Row& row, int colorColumn, const std::string& path,
                          text);
 }
 
-// Where the data starts, and what the whole file holds: the result of the pre-pass.
-struct XyzScan {
-    std::uint64_t dataOffset = 0; // byte offset of the first data line
-    std::uint64_t dataLine = 0;   // its line number
-    std::uint64_t headerLines = 0;
-    std::size_t columns = 0;
-    const char* separator = "space-separated";
+// What data lines hold: a block's, then (merged in file order) the whole file's.
+struct RecordTally {
     std::uint64_t records = 0;
     std::uint64_t nonFinite = 0;
     Bounds bounds;
     bool extraColumnsAreColorLiterals = true; // 6 columns: columns 4-6 all "0".."255"
     double intensityMin = std::numeric_limits<double>::infinity();
     double intensityMax = -std::numeric_limits<double>::infinity();
-    std::uint64_t intensityMinLine = 0;
+    std::uint64_t intensityMinLine = 0; // the first line with the smallest value
     std::uint64_t intensityMaxLine = 0;
     bool intensitiesIntegral = true;
+
+    // Adds the tally of the lines after these.
+    void merge(const RecordTally& later) {
+        records += later.records;
+        nonFinite += later.nonFinite;
+        bounds.extend(later.bounds);
+        extraColumnsAreColorLiterals =
+            extraColumnsAreColorLiterals && later.extraColumnsAreColorLiterals;
+        if (later.intensityMin < intensityMin) {
+            intensityMin = later.intensityMin;
+            intensityMinLine = later.intensityMinLine;
+        }
+        if (later.intensityMax > intensityMax) {
+            intensityMax = later.intensityMax;
+            intensityMaxLine = later.intensityMaxLine;
+        }
+        intensitiesIntegral = intensitiesIntegral && later.intensitiesIntegral;
+    }
+};
+
+// Where the data starts, and what the whole file holds: the result of the pre-pass.
+struct XyzScan : RecordTally {
+    std::uint64_t dataOffset = 0; // byte offset of the first data line
+    std::uint64_t dataLine = 0;   // its line number
+    std::uint64_t headerLines = 0;
+    std::size_t columns = 0;
+    const char* separator = "space-separated";
 };
 
 // The first data line of a file: the lines before it are header lines (or comments).
@@ -331,9 +357,10 @@ void findFirstDataLine(LineReader& lines, Row& row, XyzScan& scan, const std::st
                      "or header lines");
 }
 
-// Accounts one data line (already checked by checkRow) in the pre-pass.
-void scanRow(const Row& row, int intensityColumn, int colorColumn, XyzScan& scan,
-             const std::string& path, std::uint64_t lineNumber) {
+// Accounts one data line (already checked by checkRow) of a file with `columns` in the
+// pre-pass.
+void scanRow(const Row& row, std::size_t columns, int intensityColumn, int colorColumn,
+             RecordTally& scan, const std::string& path, std::uint64_t lineNumber) {
     ++scan.records;
     if (!row.positionFinite()) {
         ++scan.nonFinite;
@@ -343,7 +370,7 @@ void scanRow(const Row& row, int intensityColumn, int colorColumn, XyzScan& scan
     if (colorColumn >= 0) {
         checkColors(row, colorColumn, path, lineNumber);
     }
-    if (scan.columns == 6 && scan.extraColumnsAreColorLiterals) {
+    if (columns == 6 && scan.extraColumnsAreColorLiterals) {
         for (std::size_t c = 3; c < 6; ++c) {
             if (!isIntegerLiteral(row.texts[c]) || row.values[c] > 255.0) {
                 scan.extraColumnsAreColorLiterals = false;
@@ -367,33 +394,56 @@ void scanRow(const Row& row, int intensityColumn, int colorColumn, XyzScan& scan
     }
 }
 
+// A block of data lines in the pre-pass: its tally, and every record's source position
+// (NaN where not finite) when the preview samples, for the sample to be taken in file order.
+struct BlockScan {
+    RecordTally tally;
+    std::vector<glm::dvec3> positions;
+};
+
 XyzScan scanFile(FileStream& stream, PrePassMonitor& monitor) {
     const std::string& path = stream.path();
     XyzScan scan;
-    Row row;
-    stream.seek(0);
-    LineReader lines(stream);
-    monitor.advance(0);
-    findFirstDataLine(lines, row, scan, path);
+    {
+        Row row;
+        stream.seek(0);
+        LineReader lines(stream);
+        monitor.advance(0);
+        findFirstDataLine(lines, row, scan, path);
+    }
     // The 6-column layout is not decided yet; neither candidate has a colour check here.
     const ColumnLayout layout = layoutFor(scan.columns, false);
     const int colorColumn = scan.columns == 6 ? -1 : layout.color;
-    scanRow(row, layout.intensity, colorColumn, scan, path, scan.dataLine);
-    // Record scan.records - 1 was just scanned; a non-finite one is never delivered.
-    const auto sample = [&] {
-        if (monitor.samples(scan.records - 1) && row.positionFinite()) {
-            monitor.offer(glm::dvec3(row.values[0], row.values[1], row.values[2]));
+    const bool sampling = monitor.sampling();
+    const auto parse = [&](const TextBlock& block, BlockScan& part) {
+        part.tally = {};
+        part.positions.clear();
+        Row row;
+        TextBlockLines lines(block);
+        std::string_view line;
+        while (nextContentLine(lines, line)) {
+            row.parse(line);
+            checkRow(row, scan.columns, scan.dataLine, path, lines.lineNumber());
+            scanRow(row, scan.columns, layout.intensity, colorColumn, part.tally, path,
+                    lines.lineNumber());
+            if (sampling) {
+                part.positions.push_back(
+                    row.positionFinite() ? glm::dvec3(row.values[0], row.values[1], row.values[2])
+                                         : glm::dvec3(std::numeric_limits<double>::quiet_NaN()));
+            }
         }
     };
-    sample();
-    std::string_view line;
-    while (nextContentLine(lines, line)) {
-        monitor.advance(lines.lineOffset());
-        row.parse(line);
-        checkRow(row, scan.columns, scan.dataLine, path, lines.lineNumber());
-        scanRow(row, layout.intensity, colorColumn, scan, path, lines.lineNumber());
-        sample();
-    }
+    const auto merge = [&](const TextBlock& block, BlockScan& part) {
+        for (std::size_t i = 0; i < part.positions.size(); ++i) {
+            if (monitor.samples(scan.records + i) && !std::isnan(part.positions[i].x)) {
+                monitor.offer(part.positions[i]);
+            }
+        }
+        scan.merge(part.tally);
+        monitor.advance(block.endOffset());
+        return true;
+    };
+    parseTextBlocksInParallel<BlockScan>(stream, scan.dataOffset, scan.dataLine, parse, merge);
     monitor.finish();
     return scan;
 }
@@ -460,25 +510,49 @@ public:
             batch.clear();
         };
 
-        m_stream.seek(m_dataOffset);
-        LineReader lines(m_stream, m_dataLine);
-        Row row;
-        std::string_view line;
-        while (nextContentLine(lines, line)) {
-            row.parse(line);
-            checkRow(row, m_layout.columns, m_dataLine, path, lines.lineNumber());
-            if (!row.positionFinite()) {
-                ++summary.skippedNonFinite;
-                continue;
+        // Each block's points are parsed into a batch of their own, then moved into the
+        // batches delivered, batchPoints at a time.
+        struct BlockPoints {
+            PointBatch batch;
+            std::uint64_t skippedNonFinite = 0;
+        };
+        const auto parse = [&](const TextBlock& block, BlockPoints& part) {
+            part.batch.attributes = m_info.attributes;
+            part.batch.clear();
+            part.skippedNonFinite = 0;
+            Row row;
+            TextBlockLines lines(block);
+            std::string_view line;
+            while (nextContentLine(lines, line)) {
+                row.parse(line);
+                checkRow(row, m_layout.columns, m_dataLine, path, lines.lineNumber());
+                if (!row.positionFinite()) {
+                    ++part.skippedNonFinite;
+                    continue;
+                }
+                appendPoint(row, normalizer, part.batch, lines.lineNumber());
             }
-            appendPoint(row, normalizer, batch, lines.lineNumber());
-            if (batch.size() >= batchPoints) {
-                deliver();
-                if (options.cancel != nullptr && options.cancel->load()) {
-                    summary.cancelled = true;
-                    return summary;
+        };
+        const auto merge = [&](const TextBlock&, BlockPoints& part) {
+            summary.skippedNonFinite += part.skippedNonFinite;
+            for (std::size_t taken = 0; taken < part.batch.size();) {
+                const std::size_t take =
+                    std::min(part.batch.size() - taken, batchPoints - batch.size());
+                batch.appendRange(part.batch, taken, taken + take);
+                taken += take;
+                if (batch.size() >= batchPoints) {
+                    deliver();
+                    if (options.cancel != nullptr && options.cancel->load()) {
+                        summary.cancelled = true;
+                        return false;
+                    }
                 }
             }
+            return true;
+        };
+        parseTextBlocksInParallel<BlockPoints>(m_stream, m_dataOffset, m_dataLine, parse, merge);
+        if (summary.cancelled) {
+            return summary;
         }
         if (!batch.empty()) {
             deliver();

@@ -410,6 +410,73 @@ TEST(XyzMalformedFile, PointOutsideKnownBoundsThrowsAtReadWithLine) {
     }
 }
 
+// ---- files of many blocks (parsed in parallel, taken in file order) ----
+
+// `lines` data lines "i  i%1000  0.5  intensity", a comment every 1,000 lines and a
+// non-finite point every 7,777: several groups of text blocks.
+std::string manyLines(int lines) {
+    std::string text = "# x y z intensity\n";
+    for (int i = 0; i < lines; ++i) {
+        if (i % 1000 == 999) {
+            text += "// a comment\n";
+        }
+        if (i % 7777 == 7776) {
+            text += "nan 0 0 0\n";
+        }
+        text += std::to_string(i) + " " + std::to_string(i % 1000) + " 0.5 " +
+                std::to_string(i % 4096) + "\n";
+    }
+    return text;
+}
+
+TEST(XyzLargeFile, EveryPointArrivesOnceInFileOrder) {
+    constexpr int kLines = 300'000; // about 6 MB
+    const TextCloud t(manyLines(kLines));
+    ASSERT_EQ(t.cloud.points.size(), static_cast<std::size_t>(kLines));
+    EXPECT_EQ(t.cloud.summary.skippedNonFinite, static_cast<std::uint64_t>(kLines / 7777));
+    EXPECT_EQ(t.cloud.info.sourceBounds.max, glm::dvec3(kLines - 1, 999, 0.5));
+    for (int i = 0; i < kLines; i += 997) {
+        expectNear(t.source(static_cast<std::size_t>(i)), glm::dvec3(i, i % 1000, 0.5), 0.05);
+        EXPECT_EQ(t.cloud.points.intensities[static_cast<std::size_t>(i)], i % 4096);
+    }
+}
+
+// Line number of the data line `i` of manyLines (the header and the comment and non-finite
+// lines before it counted).
+std::uint64_t lineOfDataLine(int i) {
+    return 2 + static_cast<std::uint64_t>(i + (i + 1) / 1000 + (i + 1) / 7777);
+}
+
+TEST(XyzLargeFile, TheFirstBadLineOfTheFileIsNamed) {
+    constexpr int kLines = 300'000;
+    std::string text = manyLines(kLines);
+    // Break data lines 60,000 (a column missing) and 150,000 (a word for a number): in one group
+    // of blocks on two cores or more, so the later may fail first.
+    const auto lineStart = [&](int i) {
+        std::size_t at = 0;
+        for (std::uint64_t line = 1; line < lineOfDataLine(i); ++line) {
+            at = text.find('\n', at) + 1;
+        }
+        return at;
+    };
+    const std::size_t late = lineStart(150'000);
+    text.replace(late, text.find('\n', late) - late, "1 2 oops 4");
+    const std::size_t early = lineStart(60'000);
+    text.replace(early, text.find('\n', early) - early, "1 2 3");
+    TempDir dir;
+    const std::string path = dir.file("bad.xyz");
+    writeText(path, text);
+    try {
+        loadPointCloud(path);
+        FAIL() << "expected MalformedValue";
+    } catch (const InputError& error) {
+        EXPECT_EQ(error.kind(), InputErrorKind::MalformedValue) << error.what();
+        EXPECT_EQ(error.location().value, lineOfDataLine(60'000)) << error.what();
+        EXPECT_NE(std::string(error.what()).find("expected 4 columns"), std::string::npos)
+            << error.what();
+    }
+}
+
 // ---- writeXyz round trips ----
 
 TEST(XyzWriter, ColorsAndNormalsRoundTrip) {
