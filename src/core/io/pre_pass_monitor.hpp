@@ -44,6 +44,13 @@ public:
             throwCancelled();
         }
     }
+    // advance(), reporting now however few bytes were scanned since the last report: the end
+    // of a text scan's first block, so that the view has its first preview points at once.
+    void reportNow(std::uint64_t offset) {
+        if (!report(offset)) {
+            throwCancelled();
+        }
+    }
     // The scan is over: throws OpenCancelled when it was stopped, else a last report at the
     // file's size.
     void finish() {

@@ -75,20 +75,24 @@ template <typename Parsed, typename Parse, typename Merge>
 void parseTextBlocksInParallel(const FileStream& stream, std::uint64_t offset,
                                std::uint64_t firstLine, Parse&& parse, Merge&& merge) {
     // Blocks of a group are parsed in parallel; the group's last ones leave cores idle until
-    // they are done, so a group holds several blocks a core.
-    const std::size_t groupBlocks =
-        8 * static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
+    // they are done, so a group holds several blocks a core. The first group holds one a
+    // core: the first merge (a pre-pass's first preview points) comes that much sooner.
+    const auto cores =
+        static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
+    const std::size_t groupBlocks = 8 * cores;
     struct Group {
         std::vector<TextBlock> blocks;
+        std::size_t wanted = 0;
         std::size_t count = 0;
         std::exception_ptr readError; // after the blocks read before it
     };
     TextBlockReader reader(stream, offset, firstLine);
-    const auto read = [&reader, groupBlocks](Group& group) {
+    const auto read = [&reader](Group& group, std::size_t wanted) {
+        group.wanted = wanted;
         group.count = 0;
-        group.blocks.resize(groupBlocks);
+        group.blocks.resize(std::max(group.blocks.size(), wanted));
         try {
-            while (group.count < groupBlocks && reader.next(group.blocks[group.count])) {
+            while (group.count < wanted && reader.next(group.blocks[group.count])) {
                 ++group.count;
             }
         } catch (...) {
@@ -98,16 +102,16 @@ void parseTextBlocksInParallel(const FileStream& stream, std::uint64_t offset,
     Group groups[2];
     std::vector<Parsed> parsed(groupBlocks);
     std::vector<std::exception_ptr> errors(groupBlocks);
-    read(groups[0]);
+    read(groups[0], cores);
     for (int current = 0;; current = 1 - current) {
         Group& group = groups[current];
         Group& following = groups[1 - current];
         following.readError = nullptr;
         following.count = 0;
-        const bool more = group.count == groupBlocks && !group.readError;
+        const bool more = group.count == group.wanted && !group.readError;
         tbb::task_group reading;
         if (more) {
-            reading.run([&] { read(following); });
+            reading.run([&] { read(following, groupBlocks); });
         }
         tbb::parallel_for(std::size_t{0}, group.count, [&](std::size_t i) {
             errors[i] = nullptr;

@@ -439,8 +439,13 @@ XyzScan scanFile(FileStream& stream, PrePassMonitor& monitor) {
                 monitor.offer(part.positions[i]);
             }
         }
+        const bool first = scan.records == 0;
         scan.merge(part.tally);
-        monitor.advance(block.endOffset());
+        if (first) {
+            monitor.reportNow(block.endOffset());
+        } else {
+            monitor.advance(block.endOffset());
+        }
         return true;
     };
     parseTextBlocksInParallel<BlockScan>(stream, scan.dataOffset, scan.dataLine, parse, merge);

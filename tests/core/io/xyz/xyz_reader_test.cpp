@@ -3,6 +3,7 @@
 #include "io/input_error.hpp"
 #include "io/line_reader.hpp"
 #include "io/point_reader.hpp"
+#include "io/text_blocks.hpp"
 #include "io/xyz/xyz_reader.hpp"
 #include "io/xyz/xyz_writer.hpp"
 #include "scene/scene_generator.hpp"
@@ -475,6 +476,29 @@ TEST(XyzLargeFile, TheFirstBadLineOfTheFileIsNamed) {
         EXPECT_NE(std::string(error.what()).find("expected 4 columns"), std::string::npos)
             << error.what();
     }
+}
+
+TEST(XyzLargeFile, TheFirstPreviewPointsComeWithTheFirstBlock) {
+    TempDir dir;
+    const std::string path = dir.file("big.xyz");
+    writeText(path, manyLines(300'000));
+    OpenOptions options;
+    std::size_t points = 0;
+    std::uint64_t offsetOfFirstPoints = 0;
+    options.onPrePassPoints = [&](std::span<const glm::dvec3> sample) {
+        points += sample.size();
+    };
+    options.onPrePassProgress = [&](std::uint64_t offset, std::uint64_t) {
+        if (points > 0 && offsetOfFirstPoints == 0) {
+            offsetOfFirstPoints = offset;
+        }
+    };
+    openPointCloud(path, options);
+    EXPECT_GT(points, 1000u);
+    EXPECT_GT(offsetOfFirstPoints, 0u);
+    // Not a report's worth of bytes (a MiB) later: the end of the first block of lines, which
+    // starts after the header line.
+    EXPECT_LE(offsetOfFirstPoints, TextBlockReader::kBlockBytes + manyLines(0).size());
 }
 
 // ---- writeXyz round trips ----
