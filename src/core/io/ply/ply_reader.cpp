@@ -11,6 +11,7 @@
 #include "io/pre_pass_monitor.hpp"
 #include "io/record_block_reader.hpp"
 #include "io/source_normalizer.hpp"
+#include "io/text_blocks.hpp"
 
 #include <algorithm>
 #include <array>
@@ -165,6 +166,18 @@ bool nextDataLine(LineReader& lines, std::string_view& line) {
     return false;
 }
 
+// The vertex lines of one text block, parsed on any thread (io/text_blocks.hpp): the values
+// of each line that parses as a vertex, and the first line that does not, which ends the
+// block's parse. A block does not know which vertex it starts with, nor whether the vertices
+// end inside it: the merge numbers them and decides whether that line is an error.
+struct AsciiVertexLines {
+    std::vector<double> values;       // the properties' values, line after line
+    std::vector<std::uint64_t> lines; // the line number of each
+    bool stopped = false;             // a line that is no vertex ended the parse
+    std::uint64_t stopLine = 0;
+    std::string stopDetail; // what is wrong with it as a vertex
+};
+
 // ---- the reader ---------------------------------------------------------------------------
 
 class PlyReader final : public PointReader {
@@ -187,6 +200,8 @@ private:
     std::uint64_t walkRecords(PlyBodyCursor& cursor, const PlyElement& element, std::uint64_t index,
                               const std::uint8_t* useMask, double* values) const;
     template <typename OnVertex> bool visitAscii(OnVertex&& onVertex);
+    std::string parseAsciiVertex(std::string_view line, double* values) const;
+    void parseAsciiVertexLines(const TextBlock& block, AsciiVertexLines& out) const;
     template <typename OnVertex> bool visitVariableRecords(OnVertex&& onVertex);
     template <typename OnBlock> bool visitFixedBlocks(OnBlock&& onBlock);
     template <typename OnVertex> bool visitVertexValues(OnVertex&& onVertex);
@@ -222,6 +237,7 @@ private:
     std::uint64_t m_recordBytes = 0;
     std::uint64_t m_vertexStart = 0;     // byte offset of the first vertex record or line
     std::uint64_t m_vertexFirstLine = 0; // ascii: line number of the first vertex
+    std::uint64_t m_asciiProgress = 0;   // ascii: the end of the block being visited
 };
 
 PlyReader::PlyReader(const std::string& path, const OpenOptions& options) : m_stream(path) {
@@ -501,74 +517,135 @@ void PlyReader::describeFormat() {
     }
 }
 
-// Parses every vertex line: onVertex(values, vertexIndex, lineNumber) -> false stops.
+// One vertex line's values into `values` (float properties rounded to float, as a binary file
+// would store them; list items skipped). Returns what is wrong with the line as a vertex, or
+// "" when nothing is.
+std::string PlyReader::parseAsciiVertex(std::string_view line, double* values) const {
+    const PlyElement& element = vertex();
+    const char* cursor = line.data();
+    const char* end = cursor + line.size();
+    std::size_t found = 0;
+    for (std::size_t p = 0; p < element.properties.size(); ++p) {
+        const PlyProperty& property = element.properties[p];
+        const std::string_view word = nextWord(cursor, end);
+        if (word.empty()) {
+            return "found only " + std::to_string(found) + " values";
+        }
+        ++found;
+        double value = 0.0;
+        if (!parseDecimal(word, value)) {
+            return "value '" + std::string(word) + "' for property '" + property.name +
+                   "' is not a number";
+        }
+        if (!property.isList) {
+            values[p] = property.type == PlyScalarType::Float32
+                            ? static_cast<double>(static_cast<float>(value))
+                            : value;
+            continue;
+        }
+        if (!(value >= 0.0) || value != std::floor(value)) {
+            return "list length '" + std::string(word) + "' for property '" + property.name +
+                   "' is not a count >= 0";
+        }
+        for (double item = 0.0; item < value; item += 1.0) {
+            if (nextWord(cursor, end).empty()) {
+                return "list '" + property.name + "' has fewer than " + std::string(word) +
+                       " items";
+            }
+            ++found;
+        }
+    }
+    if (!nextWord(cursor, end).empty()) {
+        return "found more than the " + std::to_string(found) + " values declared";
+    }
+    return {};
+}
+
+void PlyReader::parseAsciiVertexLines(const TextBlock& block, AsciiVertexLines& out) const {
+    const std::size_t properties = vertex().properties.size();
+    out.values.clear();
+    out.lines.clear();
+    out.stopped = false;
+    TextBlockLines lines(block);
+    std::string_view line;
+    while (lines.next(line)) {
+        if (isBlank(line)) { // a trailing empty line, say: no record
+            continue;
+        }
+        const std::size_t at = out.values.size();
+        out.values.resize(at + properties);
+        std::string detail = parseAsciiVertex(line, out.values.data() + at);
+        if (!detail.empty()) {
+            out.values.resize(at);
+            out.stopped = true;
+            out.stopLine = lines.lineNumber();
+            out.stopDetail = std::move(detail);
+            return;
+        }
+        out.lines.push_back(lines.lineNumber());
+    }
+}
+
+// Every vertex line, parsed on every core a block of lines at a time and visited in order on
+// this thread: onVertex(values, vertexIndex, lineNumber) -> false stops. The same errors, at
+// the same lines, as reading line by line: the first line that is no vertex is an error where
+// a vertex is expected; after the last vertex, a data line is one only when the vertices are
+// the file's last element.
 template <typename OnVertex> bool PlyReader::visitAscii(OnVertex&& onVertex) {
     const PlyElement& element = vertex();
     const std::string& path = m_stream.path();
-    m_stream.seek(m_vertexStart);
-    LineReader lines(m_stream, m_vertexFirstLine);
-    std::vector<double> values(element.properties.size(), 0.0);
-    std::string_view line;
-    for (std::uint64_t index = 0; index < element.count; ++index) {
-        if (!nextDataLine(lines, line)) {
-            throw InputError(InputErrorKind::Truncated, path,
-                             InputLocation::line(lines.lineNumber() + 1),
-                             "expected vertex " + std::to_string(index) + " of " +
-                                 std::to_string(element.count) + ", but the file ends");
-        }
-        const std::uint64_t lineNumber = lines.lineNumber();
-        const auto malformed = [&](const std::string& detail) {
-            throw InputError(InputErrorKind::MalformedValue, path, InputLocation::line(lineNumber),
-                             "vertex " + std::to_string(index) + ": " + detail +
-                                 "; expected values for: " + m_propertyNames);
-        };
-        const char* cursor = line.data();
-        const char* end = cursor + line.size();
-        std::size_t found = 0;
-        for (std::size_t p = 0; p < element.properties.size(); ++p) {
-            const PlyProperty& property = element.properties[p];
-            const std::string_view word = nextWord(cursor, end);
-            if (word.empty()) {
-                malformed("found only " + std::to_string(found) + " values");
-            }
-            ++found;
-            double value = 0.0;
-            if (!parseDecimal(word, value)) {
-                malformed("value '" + std::string(word) + "' for property '" + property.name +
-                          "' is not a number");
-            }
-            if (!property.isList) {
-                // A float property holds a float: "0.1" is 0.1f, as a binary file would store it.
-                values[p] = property.type == PlyScalarType::Float32
-                                ? static_cast<double>(static_cast<float>(value))
-                                : value;
-                continue;
-            }
-            if (!(value >= 0.0) || value != std::floor(value)) {
-                malformed("list length '" + std::string(word) + "' for property '" + property.name +
-                          "' is not a count >= 0");
-            }
-            for (double item = 0.0; item < value; item += 1.0) {
-                if (nextWord(cursor, end).empty()) {
-                    malformed("list '" + property.name + "' has fewer than " + std::string(word) +
-                              " items");
-                }
-                ++found;
-            }
-        }
-        if (!nextWord(cursor, end).empty()) {
-            malformed("found more than the " + std::to_string(found) + " values declared");
-        }
-        if (!onVertex(values.data(), index, lineNumber)) {
-            return false;
-        }
-    }
-    if (m_vertexIsLast && nextDataLine(lines, line)) {
-        throw InputError(InputErrorKind::CountMismatch, path,
-                         InputLocation::line(lines.lineNumber()),
+    const std::size_t properties = element.properties.size();
+    const auto moreData = [&](std::uint64_t line) {
+        throw InputError(InputErrorKind::CountMismatch, path, InputLocation::line(line),
                          "expected the file to end after " + std::to_string(element.count) +
                              " vertex lines, but more data follows (is the header's vertex "
                              "count too small?)");
+    };
+    std::uint64_t index = 0;    // vertices visited
+    std::uint64_t lastLine = 0; // the number of the last line read
+    bool stopped = false;       // by onVertex
+    parseTextBlocksInParallel<AsciiVertexLines>(
+        m_stream, m_vertexStart, m_vertexFirstLine,
+        [this](const TextBlock& block, AsciiVertexLines& out) {
+            parseAsciiVertexLines(block, out);
+        },
+        [&](const TextBlock& block, AsciiVertexLines& part) {
+            m_asciiProgress = block.endOffset();
+            lastLine = block.firstLine + block.lines - (block.bytes.back() == '\n' ? 1 : 0);
+            for (std::size_t i = 0; i < part.lines.size(); ++i) {
+                if (index == element.count) {
+                    if (m_vertexIsLast) {
+                        moreData(part.lines[i]);
+                    }
+                    return false;
+                }
+                if (!onVertex(part.values.data() + i * properties, index, part.lines[i])) {
+                    stopped = true;
+                    return false;
+                }
+                ++index;
+            }
+            if (part.stopped) {
+                if (index == element.count) {
+                    if (m_vertexIsLast) {
+                        moreData(part.stopLine);
+                    }
+                    return false;
+                }
+                throw InputError(InputErrorKind::MalformedValue, path,
+                                 InputLocation::line(part.stopLine),
+                                 "vertex " + std::to_string(index) + ": " + part.stopDetail +
+                                     "; expected values for: " + m_propertyNames);
+            }
+            return index < element.count || m_vertexIsLast;
+        });
+    if (stopped) {
+        return false;
+    }
+    if (index < element.count) {
+        throw InputError(InputErrorKind::Truncated, path, InputLocation::line(lastLine + 1),
+                         "expected vertex " + std::to_string(index) + " of " +
+                             std::to_string(element.count) + ", but the file ends");
     }
     return true;
 }
@@ -782,9 +859,9 @@ void PlyReader::runBoundsPrePass(const OpenOptions& options) {
                     monitor.offer(source);
                 }
             }
-            // Ascii vertices are numbered by line: the bytes read so far stand for progress
-            // (the line reader reads from this thread, a block at a time).
-            return monitor.reached(binary() ? byteOrLine : m_stream.position());
+            // Ascii vertices are numbered by line: the end of the block of lines they are
+            // visited from stands for progress.
+            return monitor.reached(binary() ? byteOrLine : m_asciiProgress);
         });
     }
     monitor.finish();

@@ -882,6 +882,96 @@ TEST(PlyReaderStreaming, PointOutsideKnownBoundsThrowsOutOfBounds) {
     expectReadError(asciiPath, InputErrorKind::OutOfBounds, "line 9: ", options);
 }
 
+// ---- ascii bodies of many blocks (parsed in parallel, visited in file order) ---------------
+
+// An ascii PLY of `vertices` vertices "i i%1000 0.5" (blank lines sprinkled in), followed by
+// `faces` face lines of four corners when faces > 0.
+std::string asciiPly(int vertices, int faces) {
+    std::string text = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(vertices) +
+                       "\nproperty float x\nproperty float y\nproperty float z\n";
+    if (faces > 0) {
+        text += "element face " + std::to_string(faces) + "\nproperty list uchar int idx\n";
+    }
+    text += "end_header\n";
+    for (int i = 0; i < vertices; ++i) {
+        text += std::to_string(i) + " " + std::to_string(i % 1000) + " 0.5\n";
+        if (i % 5000 == 0) {
+            text += "\n";
+        }
+    }
+    for (int f = 0; f < faces; ++f) {
+        text += "4 0 1 2 3\n";
+    }
+    return text;
+}
+
+// The line of vertex `i` in asciiPly: 7 header lines (9 with faces) and the blank lines.
+std::uint64_t lineOfVertex(int i, bool faces) {
+    return (faces ? 10 : 8) + static_cast<std::uint64_t>(i + (i + 4999) / 5000);
+}
+
+TEST(PlyReaderAsciiBlocks, EveryVertexInFileOrderAndTheFacesAfterThemAreNotRead) {
+    test::TempDir dir;
+    const std::string path = dir.file("mesh.ply");
+    constexpr int kVertices = 200'000; // about 3 MB: several groups of blocks
+    test::writeText(path, asciiPly(kVertices, 100'000));
+    const ReadResult result = readAll(path);
+    ASSERT_EQ(result.points.size(), static_cast<std::size_t>(kVertices));
+    EXPECT_EQ(result.info.sourceBounds.max, glm::dvec3(kVertices - 1, 999, 0.5));
+    for (int i = 0; i < kVertices; i += 991) {
+        const glm::dvec3 source = result.info.cube.toSource(result.points.positions[i]);
+        EXPECT_NEAR(source.x, i, 0.05);
+        EXPECT_NEAR(source.y, i % 1000, 0.05);
+    }
+}
+
+TEST(PlyReaderAsciiBlocks, TheFirstBadVertexOfTheFileIsNamed) {
+    test::TempDir dir;
+    const std::string path = dir.file("bad.ply");
+    std::string text = asciiPly(200'000, 0);
+    const auto replaceLine = [&](std::uint64_t number, const std::string& with) {
+        std::size_t at = 0;
+        for (std::uint64_t line = 1; line < number; ++line) {
+            at = text.find('\n', at) + 1;
+        }
+        text.replace(at, text.find('\n', at) - at, with);
+    };
+    // Two bad vertices in one group of blocks (on two cores or more): the later may fail first.
+    replaceLine(lineOfVertex(150'000, false), "1 2 oops");
+    replaceLine(lineOfVertex(60'000, false), "1 2");
+    test::writeText(path, text);
+    const std::string message =
+        expectInputError([&] { openPlyReader(path, {}); }, InputErrorKind::MalformedValue, path,
+                         "line " + std::to_string(lineOfVertex(60'000, false)) + ": ");
+    EXPECT_NE(message.find("vertex 60000: found only 2 values"), std::string::npos) << message;
+}
+
+TEST(PlyReaderAsciiBlocks, DataAfterTheLastVertexBlocksLaterIsAnError) {
+    test::TempDir dir;
+    const std::string path = dir.file("more.ply");
+    // The header says 100,000 vertices, the body holds 200,000: the first extra one is named.
+    std::string text = asciiPly(200'000, 0);
+    text.replace(text.find("element vertex 200000"), 21, "element vertex 100000");
+    test::writeText(path, text);
+    const std::string message =
+        expectInputError([&] { openPlyReader(path, {}); }, InputErrorKind::CountMismatch, path,
+                         "line " + std::to_string(lineOfVertex(100'000, false)) + ": ");
+    EXPECT_NE(message.find("vertex count"), std::string::npos) << message;
+}
+
+TEST(PlyReaderAsciiBlocks, FewerVerticesThanDeclaredNameTheLineAfterTheLast) {
+    test::TempDir dir;
+    const std::string path = dir.file("short.ply");
+    std::string text = asciiPly(200'000, 0);
+    text.replace(text.find("element vertex 200000"), 21, "element vertex 300000");
+    test::writeText(path, text);
+    const auto lines = static_cast<std::uint64_t>(std::count(text.begin(), text.end(), '\n'));
+    const std::string message =
+        expectInputError([&] { openPlyReader(path, {}); }, InputErrorKind::Truncated, path,
+                         "line " + std::to_string(lines + 1) + ": ");
+    EXPECT_NE(message.find("vertex 200000 of 300000"), std::string::npos) << message;
+}
+
 // ---- malformed input ---------------------------------------------------------------------
 
 struct MalformedHeader {
