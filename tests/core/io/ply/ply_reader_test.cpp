@@ -925,9 +925,18 @@ TEST(PlyReaderAsciiBlocks, EveryVertexInFileOrderAndTheFacesAfterThemAreNotRead)
     }
 }
 
-TEST(PlyReaderAsciiBlocks, TheFirstBadVertexOfTheFileIsNamed) {
+// Opening `text` saved as a PLY fails with `kind` at line `line`, saying `mention`.
+void expectAsciiOpenError(const std::string& text, InputErrorKind kind, std::uint64_t line,
+                          const std::string& mention) {
     test::TempDir dir;
-    const std::string path = dir.file("bad.ply");
+    const std::string path = dir.file("body.ply");
+    test::writeText(path, text);
+    const std::string message = expectInputError([&] { openPlyReader(path, {}); }, kind, path,
+                                                 "line " + std::to_string(line) + ": ");
+    EXPECT_NE(message.find(mention), std::string::npos) << message;
+}
+
+TEST(PlyReaderAsciiBlocks, TheFirstBadVertexOfTheFileIsNamed) {
     std::string text = asciiPly(200'000, 0);
     const auto replaceLine = [&](std::uint64_t number, const std::string& with) {
         std::size_t at = 0;
@@ -939,37 +948,23 @@ TEST(PlyReaderAsciiBlocks, TheFirstBadVertexOfTheFileIsNamed) {
     // Two bad vertices in one group of blocks (on two cores or more): the later may fail first.
     replaceLine(lineOfVertex(150'000, false), "1 2 oops");
     replaceLine(lineOfVertex(60'000, false), "1 2");
-    test::writeText(path, text);
-    const std::string message =
-        expectInputError([&] { openPlyReader(path, {}); }, InputErrorKind::MalformedValue, path,
-                         "line " + std::to_string(lineOfVertex(60'000, false)) + ": ");
-    EXPECT_NE(message.find("vertex 60000: found only 2 values"), std::string::npos) << message;
+    expectAsciiOpenError(text, InputErrorKind::MalformedValue, lineOfVertex(60'000, false),
+                         "vertex 60000: found only 2 values");
 }
 
 TEST(PlyReaderAsciiBlocks, DataAfterTheLastVertexBlocksLaterIsAnError) {
-    test::TempDir dir;
-    const std::string path = dir.file("more.ply");
     // The header says 100,000 vertices, the body holds 200,000: the first extra one is named.
     std::string text = asciiPly(200'000, 0);
     text.replace(text.find("element vertex 200000"), 21, "element vertex 100000");
-    test::writeText(path, text);
-    const std::string message =
-        expectInputError([&] { openPlyReader(path, {}); }, InputErrorKind::CountMismatch, path,
-                         "line " + std::to_string(lineOfVertex(100'000, false)) + ": ");
-    EXPECT_NE(message.find("vertex count"), std::string::npos) << message;
+    expectAsciiOpenError(text, InputErrorKind::CountMismatch, lineOfVertex(100'000, false),
+                         "vertex count");
 }
 
 TEST(PlyReaderAsciiBlocks, FewerVerticesThanDeclaredNameTheLineAfterTheLast) {
-    test::TempDir dir;
-    const std::string path = dir.file("short.ply");
     std::string text = asciiPly(200'000, 0);
     text.replace(text.find("element vertex 200000"), 21, "element vertex 300000");
-    test::writeText(path, text);
     const auto lines = static_cast<std::uint64_t>(std::count(text.begin(), text.end(), '\n'));
-    const std::string message =
-        expectInputError([&] { openPlyReader(path, {}); }, InputErrorKind::Truncated, path,
-                         "line " + std::to_string(lines + 1) + ": ");
-    EXPECT_NE(message.find("vertex 200000 of 300000"), std::string::npos) << message;
+    expectAsciiOpenError(text, InputErrorKind::Truncated, lines + 1, "vertex 200000 of 300000");
 }
 
 // ---- malformed input ---------------------------------------------------------------------
