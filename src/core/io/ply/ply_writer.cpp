@@ -1,14 +1,16 @@
 #include "io/ply/ply_writer.hpp"
 
+#include "io/parallel_text_writer.hpp"
+
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <cassert>
 #include <charconv>
 #include <cmath>
-#include <glm/common.hpp>
 #include <cstdio>
 #include <cstring>
+#include <glm/common.hpp>
 
 namespace omicron {
 
@@ -142,37 +144,35 @@ void writeAsciiBody(AtomicFileWriter& out, const PointBatch& points, const CubeT
     const bool normals = points.attributes.has(Attribute::Normal);
     const bool colors = points.attributes.has(Attribute::Color);
     const bool intensities = points.attributes.has(Attribute::Intensity);
-    std::string text;
-    for (std::size_t start = 0; start < points.size(); start += kChunkPoints) {
-        const std::size_t end = std::min(points.size(), start + kChunkPoints);
-        text.clear();
-        for (std::size_t i = start; i < end; ++i) {
-            const glm::vec3 stored = storedPosition(points.positions[i], cube, options.offset);
-            appendFloat(text, stored.x);
-            text += ' ';
-            appendFloat(text, stored.y);
-            text += ' ';
-            appendFloat(text, stored.z);
-            if (normals) {
-                for (int axis = 0; axis < 3; ++axis) {
-                    text += ' ';
-                    appendFloat(text, points.normals[i][axis]);
-                }
-            }
-            if (colors) {
-                for (int channel = 0; channel < 3; ++channel) {
-                    text += ' ';
-                    appendUnsigned(text, points.colors[i][channel]);
-                }
-            }
-            if (intensities) {
-                text += ' ';
-                appendUnsigned(text, points.intensities[i]);
-            }
-            text += '\n';
-        }
-        out.write(text);
-    }
+    writeTextInParallel(out, points.size(), kChunkPoints,
+                        [&](std::size_t begin, std::size_t end, std::string& text) {
+                            for (std::size_t i = begin; i < end; ++i) {
+                                const glm::vec3 stored =
+                                    storedPosition(points.positions[i], cube, options.offset);
+                                appendFloat(text, stored.x);
+                                text += ' ';
+                                appendFloat(text, stored.y);
+                                text += ' ';
+                                appendFloat(text, stored.z);
+                                if (normals) {
+                                    for (int axis = 0; axis < 3; ++axis) {
+                                        text += ' ';
+                                        appendFloat(text, points.normals[i][axis]);
+                                    }
+                                }
+                                if (colors) {
+                                    for (int channel = 0; channel < 3; ++channel) {
+                                        text += ' ';
+                                        appendUnsigned(text, points.colors[i][channel]);
+                                    }
+                                }
+                                if (intensities) {
+                                    text += ' ';
+                                    appendUnsigned(text, points.intensities[i]);
+                                }
+                                text += '\n';
+                            }
+                        });
 }
 
 } // namespace

@@ -1,5 +1,7 @@
 #include "io/xyz/xyz_writer.hpp"
 
+#include "io/parallel_text_writer.hpp"
+
 #include <algorithm>
 #include <array>
 #include <charconv>
@@ -29,9 +31,9 @@ public:
         separate();
         m_cursor = std::to_chars(m_cursor, m_text.data() + m_text.size(), value).ptr;
     }
-    void finish(AtomicFileWriter& out) {
+    void finish(std::string& text) {
         *m_cursor++ = '\n';
-        out.write(m_text.data(), static_cast<std::size_t>(m_cursor - m_text.data()));
+        text.append(m_text.data(), static_cast<std::size_t>(m_cursor - m_text.data()));
         m_cursor = m_text.data();
     }
 
@@ -61,27 +63,32 @@ void writeXyz(const std::string& path, const PointBatch& points, const CubeTrans
     header += colors ? " r g b" : "";
     header += normals ? " nx ny nz" : "";
     out.write(header + "\n");
-    LineBuilder line;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        const glm::dvec3 source = cube.toSource(points.positions[i]) - offset;
-        line.number(source.x, decimals);
-        line.number(source.y, decimals);
-        line.number(source.z, decimals);
-        if (intensities) {
-            line.integer(points.intensities[i]);
-        }
-        if (colors) {
-            for (int c = 0; c < 3; ++c) {
-                line.integer(points.colors[i][c]);
-            }
-        }
-        if (normals) {
-            for (int c = 0; c < 3; ++c) {
-                line.number(points.normals[i][c], kNormalDecimals);
-            }
-        }
-        line.finish(out);
-    }
+    constexpr std::size_t kChunkPoints = 16384;
+    writeTextInParallel(out, points.size(), kChunkPoints,
+                        [&](std::size_t begin, std::size_t end, std::string& text) {
+                            LineBuilder line;
+                            for (std::size_t i = begin; i < end; ++i) {
+                                const glm::dvec3 source =
+                                    cube.toSource(points.positions[i]) - offset;
+                                line.number(source.x, decimals);
+                                line.number(source.y, decimals);
+                                line.number(source.z, decimals);
+                                if (intensities) {
+                                    line.integer(points.intensities[i]);
+                                }
+                                if (colors) {
+                                    for (int c = 0; c < 3; ++c) {
+                                        line.integer(points.colors[i][c]);
+                                    }
+                                }
+                                if (normals) {
+                                    for (int c = 0; c < 3; ++c) {
+                                        line.number(points.normals[i][c], kNormalDecimals);
+                                    }
+                                }
+                                line.finish(text);
+                            }
+                        });
     out.commit();
 }
 
