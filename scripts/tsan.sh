@@ -4,7 +4,7 @@
 # -DTBB_SANITIZE=thread into build/tbb-tsan, builds the `tsan` preset against it and runs the
 # concurrency-heavy tests (sorter, radix sort, .oms streaming, cut and builder with a reader
 # thread, LAZ chunks decoded in parallel, LAS and PLY blocks read ahead, LAS runs parsed in
-# slices, the PLY bounds pre-pass on every core, XYZ text parsed in blocks on every core).
+# slices, the PLY bounds pre-pass on every core, text parsed and formatted on every core).
 # Extra arguments replace the default test filter, e.g. ./scripts/tsan.sh '*Builder*'.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -36,7 +36,7 @@ fi
 
 cmake --preset tsan -DTBB_DIR="$tbb_prefix/lib/cmake/TBB" >/dev/null
 cmake --build build/tsan --target omicron_core_tests
-filter=${1:-'*Builder*:*Sorter*:*Radix*:*Oms*:*ObliqueCut*:*Front*:*Packed*:*ChunkedArena*:*LeafRuns*:*ExternalSort*:*Budgeted*:*PrePass*:*OmhPaged*:*ResidentPages*:*OverlappedBatchConsumer*:*OmhWriter*:*OmhSafeSave*:*UniformColumns*:*BackgroundJob*:*ResidentSetGovernor*:*LazDecoder*:*LasReaderTest*:*PlyReader*:*ParallelRecordScan*:*TextBlocks*:*Xyz*'}
+filter=${1:-'*Builder*:*Sorter*:*Radix*:*Oms*:*ObliqueCut*:*Front*:*Packed*:*ChunkedArena*:*LeafRuns*:*ExternalSort*:*Budgeted*:*PrePass*:*OmhPaged*:*ResidentPages*:*OverlappedBatchConsumer*:*OmhWriter*:*OmhSafeSave*:*UniformColumns*:*BackgroundJob*:*ResidentSetGovernor*:*LazDecoder*:*LasReaderTest*:*PlyReader*:*ParallelRecordScan*:*TextBlocks*:*Xyz*:*ParallelTextWriter*'}
 # halt_on_error: the first race fails the job.
 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
   LD_LIBRARY_PATH="$tbb_prefix/lib" ./build/tsan/bin/omicron_core_tests --gtest_filter="$filter"
