@@ -90,6 +90,7 @@ void parseTextBlocksInParallel(const FileStream& stream, std::uint64_t offset,
     const auto read = [&reader](Group& group, std::size_t wanted) {
         group.wanted = wanted;
         group.count = 0;
+        group.readError = nullptr;
         group.blocks.resize(std::max(group.blocks.size(), wanted));
         try {
             while (group.count < wanted && reader.next(group.blocks[group.count])) {
@@ -106,8 +107,6 @@ void parseTextBlocksInParallel(const FileStream& stream, std::uint64_t offset,
     for (int current = 0;; current = 1 - current) {
         Group& group = groups[current];
         Group& following = groups[1 - current];
-        following.readError = nullptr;
-        following.count = 0;
         const bool more = group.count == group.wanted && !group.readError;
         tbb::task_group reading;
         if (more) {

@@ -5,17 +5,16 @@
 #include "test_files.hpp"
 
 #include <atomic>
-#include <fstream>
 #include <gtest/gtest.h>
-#include <iterator>
 #include <string>
+#include <vector>
 
 namespace omicron {
 namespace {
 
 std::string contentsOf(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const std::vector<std::uint8_t> bytes = test::readBytes(path);
+    return {bytes.begin(), bytes.end()};
 }
 
 TEST(ParallelTextWriter, TheFileIsThePointsInOrder) {

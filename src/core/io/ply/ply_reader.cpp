@@ -595,11 +595,16 @@ template <typename OnVertex> bool PlyReader::visitAscii(OnVertex&& onVertex) {
     const PlyElement& element = vertex();
     const std::string& path = m_stream.path();
     const std::size_t properties = element.properties.size();
-    const auto moreData = [&](std::uint64_t line) {
-        throw InputError(InputErrorKind::CountMismatch, path, InputLocation::line(line),
-                         "expected the file to end after " + std::to_string(element.count) +
-                             " vertex lines, but more data follows (is the header's vertex "
-                             "count too small?)");
+    // A data line after the last vertex: an error only when the vertices end the file.
+    // Returns false: nothing after it is read.
+    const auto afterTheVertices = [&](std::uint64_t line) {
+        if (m_vertexIsLast) {
+            throw InputError(InputErrorKind::CountMismatch, path, InputLocation::line(line),
+                             "expected the file to end after " + std::to_string(element.count) +
+                                 " vertex lines, but more data follows (is the header's vertex "
+                                 "count too small?)");
+        }
+        return false;
     };
     std::uint64_t index = 0;    // vertices visited
     std::uint64_t lastLine = 0; // the number of the last line read
@@ -614,10 +619,7 @@ template <typename OnVertex> bool PlyReader::visitAscii(OnVertex&& onVertex) {
             lastLine = block.firstLine + block.lines - (block.bytes.back() == '\n' ? 1 : 0);
             for (std::size_t i = 0; i < part.lines.size(); ++i) {
                 if (index == element.count) {
-                    if (m_vertexIsLast) {
-                        moreData(part.lines[i]);
-                    }
-                    return false;
+                    return afterTheVertices(part.lines[i]);
                 }
                 if (!onVertex(part.values.data() + i * properties, index, part.lines[i])) {
                     stopped = true;
@@ -627,10 +629,7 @@ template <typename OnVertex> bool PlyReader::visitAscii(OnVertex&& onVertex) {
             }
             if (part.stopped) {
                 if (index == element.count) {
-                    if (m_vertexIsLast) {
-                        moreData(part.stopLine);
-                    }
-                    return false;
+                    return afterTheVertices(part.stopLine);
                 }
                 throw InputError(InputErrorKind::MalformedValue, path,
                                  InputLocation::line(part.stopLine),
@@ -780,7 +779,7 @@ void PlyReader::scanFixedRecordBounds(PrePassMonitor& monitor, Bounds& bounds,
                                       std::uint64_t& finite) {
     const FloatRecordLayout layout = floatLayout();
     const RecordArray array{m_vertexStart, m_recordBytes, vertex().count};
-    const bool sampling = monitor.samples(0);
+    const bool sampling = monitor.sampling();
     const std::uint64_t stride = monitor.sampleStride();
     std::vector<std::vector<glm::dvec3>> blockSamples(
         sampling ? static_cast<std::size_t>(recordBlockCount(array, kBlockBytes)) : 0);

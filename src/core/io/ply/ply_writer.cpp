@@ -139,39 +139,45 @@ void appendUnsigned(std::string& line, unsigned value) {
     line.append(text, result.ptr);
 }
 
-void writeAsciiBody(AtomicFileWriter& out, const PointBatch& points, const CubeTransform& cube,
-                    const PlyWriteOptions& options) {
+// The ascii lines of points [begin, end), appended to `text`.
+void appendAsciiLines(const PointBatch& points, const CubeTransform& cube,
+                      const PlyWriteOptions& options, std::size_t begin, std::size_t end,
+                      std::string& text) {
     const bool normals = points.attributes.has(Attribute::Normal);
     const bool colors = points.attributes.has(Attribute::Color);
     const bool intensities = points.attributes.has(Attribute::Intensity);
+    for (std::size_t i = begin; i < end; ++i) {
+        const glm::vec3 stored = storedPosition(points.positions[i], cube, options.offset);
+        appendFloat(text, stored.x);
+        text += ' ';
+        appendFloat(text, stored.y);
+        text += ' ';
+        appendFloat(text, stored.z);
+        if (normals) {
+            for (int axis = 0; axis < 3; ++axis) {
+                text += ' ';
+                appendFloat(text, points.normals[i][axis]);
+            }
+        }
+        if (colors) {
+            for (int channel = 0; channel < 3; ++channel) {
+                text += ' ';
+                appendUnsigned(text, points.colors[i][channel]);
+            }
+        }
+        if (intensities) {
+            text += ' ';
+            appendUnsigned(text, points.intensities[i]);
+        }
+        text += '\n';
+    }
+}
+
+void writeAsciiBody(AtomicFileWriter& out, const PointBatch& points, const CubeTransform& cube,
+                    const PlyWriteOptions& options) {
     writeTextInParallel(out, points.size(), kChunkPoints,
                         [&](std::size_t begin, std::size_t end, std::string& text) {
-                            for (std::size_t i = begin; i < end; ++i) {
-                                const glm::vec3 stored =
-                                    storedPosition(points.positions[i], cube, options.offset);
-                                appendFloat(text, stored.x);
-                                text += ' ';
-                                appendFloat(text, stored.y);
-                                text += ' ';
-                                appendFloat(text, stored.z);
-                                if (normals) {
-                                    for (int axis = 0; axis < 3; ++axis) {
-                                        text += ' ';
-                                        appendFloat(text, points.normals[i][axis]);
-                                    }
-                                }
-                                if (colors) {
-                                    for (int channel = 0; channel < 3; ++channel) {
-                                        text += ' ';
-                                        appendUnsigned(text, points.colors[i][channel]);
-                                    }
-                                }
-                                if (intensities) {
-                                    text += ' ';
-                                    appendUnsigned(text, points.intensities[i]);
-                                }
-                                text += '\n';
-                            }
+                            appendAsciiLines(points, cube, options, begin, end, text);
                         });
 }
 

@@ -48,46 +48,64 @@ private:
     char* m_cursor = m_text.data();
 };
 
+// What a point's line holds: intensity only without normals (the reader has no layout with
+// both), positions with as many decimals as the cube's float resolution needs.
+struct XyzColumns {
+    bool normals;
+    bool colors;
+    bool intensities;
+    int decimals;
+
+    static XyzColumns of(const PointBatch& points, const CubeTransform& cube) {
+        const bool normals = points.attributes.has(Attribute::Normal);
+        return {normals, points.attributes.has(Attribute::Color),
+                points.attributes.has(Attribute::Intensity) && !normals,
+                positionDecimals(cube.edge)};
+    }
+};
+
+// The lines of points [begin, end), appended to `text`.
+void appendXyzLines(const PointBatch& points, const CubeTransform& cube, const glm::dvec3& offset,
+                    const XyzColumns& columns, std::size_t begin, std::size_t end,
+                    std::string& text) {
+    LineBuilder line;
+    for (std::size_t i = begin; i < end; ++i) {
+        const glm::dvec3 source = cube.toSource(points.positions[i]) - offset;
+        line.number(source.x, columns.decimals);
+        line.number(source.y, columns.decimals);
+        line.number(source.z, columns.decimals);
+        if (columns.intensities) {
+            line.integer(points.intensities[i]);
+        }
+        if (columns.colors) {
+            for (int c = 0; c < 3; ++c) {
+                line.integer(points.colors[i][c]);
+            }
+        }
+        if (columns.normals) {
+            for (int c = 0; c < 3; ++c) {
+                line.number(points.normals[i][c], kNormalDecimals);
+            }
+        }
+        line.finish(text);
+    }
+}
+
 } // namespace
 
 void writeXyz(const std::string& path, const PointBatch& points, const CubeTransform& cube,
               const glm::dvec3& offset) {
-    const bool normals = points.attributes.has(Attribute::Normal);
-    const bool colors = points.attributes.has(Attribute::Color);
-    const bool intensities = points.attributes.has(Attribute::Intensity) && !normals;
-    const int decimals = positionDecimals(cube.edge);
-
+    const XyzColumns columns = XyzColumns::of(points, cube);
     AtomicFileWriter out(path);
     std::string header = "# x y z";
-    header += intensities ? " intensity" : "";
-    header += colors ? " r g b" : "";
-    header += normals ? " nx ny nz" : "";
+    header += columns.intensities ? " intensity" : "";
+    header += columns.colors ? " r g b" : "";
+    header += columns.normals ? " nx ny nz" : "";
     out.write(header + "\n");
     constexpr std::size_t kChunkPoints = 16384;
     writeTextInParallel(out, points.size(), kChunkPoints,
                         [&](std::size_t begin, std::size_t end, std::string& text) {
-                            LineBuilder line;
-                            for (std::size_t i = begin; i < end; ++i) {
-                                const glm::dvec3 source =
-                                    cube.toSource(points.positions[i]) - offset;
-                                line.number(source.x, decimals);
-                                line.number(source.y, decimals);
-                                line.number(source.z, decimals);
-                                if (intensities) {
-                                    line.integer(points.intensities[i]);
-                                }
-                                if (colors) {
-                                    for (int c = 0; c < 3; ++c) {
-                                        line.integer(points.colors[i][c]);
-                                    }
-                                }
-                                if (normals) {
-                                    for (int c = 0; c < 3; ++c) {
-                                        line.number(points.normals[i][c], kNormalDecimals);
-                                    }
-                                }
-                                line.finish(text);
-                            }
+                            appendXyzLines(points, cube, offset, columns, begin, end, text);
                         });
     out.commit();
 }
