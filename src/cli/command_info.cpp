@@ -191,6 +191,13 @@ InfoReport readSortedStream(const std::string& path) {
     report.info.formatDetail = "omicron .oms version " + std::to_string(oms.version) +
                                ", Morton order at depth " + std::to_string(oms.sortDepth) + ", " +
                                std::to_string(oms.recordBytes) + "-byte records";
+    // Columns stored once in the header (version 2) instead of in every record.
+    if (oms.uniform.intensityUniform()) {
+        report.info.formatDetail += ", uniform intensity " + std::to_string(oms.uniform.intensity);
+    }
+    if (oms.uniform.lasUniform()) {
+        report.info.formatDetail += ", uniform LAS record";
+    }
     report.info.pointCount = oms.pointCount;
     report.info.attributes = oms.attributes;
     report.info.sourceOffset = oms.sourceOffset;

@@ -52,8 +52,9 @@ SortToOmsResult sortToOms(const std::string& inPath, const std::string& outPath,
     const auto openOnce = [&](const SortedCloud& cloud) {
         if (result.written == 0) {
             result.firstSortedSeconds = seconds(sortStart);
+            // A column the sort kept uniform (an in-memory sort) goes in the header once.
             writer.open(outPath, cloud.cube(), cloud.sourceOffset(), cloud.attributes(),
-                        sorter.pointCount());
+                        sorter.pointCount(), oms::uniformColumnsOf(cloud));
         }
     };
     if (sorter.spills()) {

@@ -87,6 +87,43 @@ INSTANTIATE_TEST_SUITE_P(Files, CliSortExport,
                                            "autzen_south.ply"),
                          test::FileParamName());
 
+// A LAS file whose intensities and LAS fields are all zero (converted from PLY) sorts into a
+// .oms that keeps them once in its header (version 2): the file is the records without them,
+// `info` names them, and building from it gives the same hierarchy as building from the LAS.
+// A scan whose fields vary keeps them in every record.
+TEST(CliSort, UniformLasColumnsAreStoredOnce) {
+    OMICRON_REQUIRE_SHARED_FILE(ply, "autzen_trim.ply");
+    OMICRON_REQUIRE_SHARED_FILE(scan, "autzen_trim.las");
+    test::TempDir dir;
+    const std::string las = dir.file("converted.las");
+    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"convert", ply, las}).exitCode, 0);
+    const std::string oms = dir.file("converted.oms");
+    const auto sorted = runProcess(OMICRON_CLI_PATH, {"sort", las, oms});
+    ASSERT_EQ(sorted.exitCode, 0) << sorted.err;
+    const std::uint64_t points = openPointCloud(las)->info().pointCount;
+    EXPECT_EQ(std::filesystem::file_size(oms), 128 + points * 15 + 24) << "position and colour";
+    const auto info = runProcess(OMICRON_CLI_PATH, {"info", oms});
+    ASSERT_EQ(info.exitCode, 0) << info.err;
+    EXPECT_NE(info.out.find("version 2, Morton order at depth 21, 15-byte records, uniform "
+                            "intensity 0, uniform LAS record"),
+              std::string::npos)
+        << info.out;
+
+    // The level table and point counts: everything `build` prints before its timings.
+    const auto hierarchyOf = [](const std::string& input) {
+        const auto built = runProcess(OMICRON_CLI_PATH, {"build", input});
+        EXPECT_EQ(built.exitCode, 0) << built.err;
+        const std::size_t from = built.out.find("points:");
+        return built.out.substr(from, built.out.find("time:") - from);
+    };
+    EXPECT_EQ(hierarchyOf(oms), hierarchyOf(las));
+
+    const std::string scanOms = dir.file("scan.oms");
+    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"sort", scan, scanOms}).exitCode, 0);
+    const auto scanInfo = runProcess(OMICRON_CLI_PATH, {"info", scanOms});
+    EXPECT_EQ(scanInfo.out.find("uniform"), std::string::npos) << scanInfo.out;
+}
+
 TEST(CliSort, BadInputFailsWithExitOneAndLeavesNoOutput) {
     test::TempDir dir;
     const std::string broken = dir.file("broken.ply");

@@ -12,6 +12,33 @@ std::uint64_t headerChecksum(const std::uint8_t* headerBytes) {
     return XXH64(headerBytes, header::kChecksum, 0);
 }
 
+UniformColumns uniformColumnsOf(const SortedCloud& cloud) {
+    UniformColumns uniform;
+    if (cloud.uniformIntensities()) {
+        uniform.bits |= kUniformIntensityBit;
+        uniform.intensity = cloud.intensities()[0];
+    }
+    const std::size_t lasBytes = cloud.attributes().lasBytes();
+    if (cloud.uniformLasColumn() && lasBytes <= kMaxUniformLasBytes) {
+        uniform.bits |= kUniformLasBit;
+        uniform.lasRecord.assign(cloud.lasRecord(0), cloud.lasRecord(0) + lasBytes);
+    }
+    return uniform;
+}
+
+RecordLayout storedRecordLayout(AttributeSet attributes, const UniformColumns& uniform) {
+    RecordLayout layout = RecordLayout::of(attributes);
+    if (uniform.intensityUniform() && attributes.has(Attribute::Intensity)) {
+        layout.lasOffset -= sizeof(std::uint16_t);
+        layout.bytes -= sizeof(std::uint16_t);
+    }
+    if (uniform.lasUniform()) {
+        layout.bytes -= layout.lasBytes;
+        layout.lasBytes = 0;
+    }
+    return layout;
+}
+
 struct PayloadChecksum::State {
     XXH3_state_t xxh3;
 };

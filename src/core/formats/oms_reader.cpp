@@ -1,5 +1,6 @@
 #include "formats/oms_reader.hpp"
 
+#include "formats/oms_record_decoder.hpp"
 #include "io/input_error.hpp"
 #include "io/raw_bytes.hpp"
 #include "sort/budgeted_cloud.hpp"
@@ -11,7 +12,9 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
+#include <vector>
 
 namespace omicron {
 
@@ -59,6 +62,78 @@ std::string lowerExtension(const std::string& path) {
     std::transform(extension.begin(), extension.end(), extension.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     return extension;
+}
+
+// The first of header bytes [begin, end) that is not zero.
+std::optional<std::size_t> firstNonZero(const std::array<std::uint8_t, oms::kHeaderBytes>& header,
+                                        std::size_t begin, std::size_t end) {
+    for (std::size_t at = begin; at < end; ++at) {
+        if (header[at] != 0) {
+            return at;
+        }
+    }
+    return std::nullopt;
+}
+
+// The uniform columns of a version 2 header (version 1: none, its fields reserved zeros),
+// checked against the attributes; unused bytes of those fields must be zero.
+oms::UniformColumns parseUniformColumns(const std::array<std::uint8_t, oms::kHeaderBytes>& header,
+                                        std::uint32_t version, AttributeSet attributes,
+                                        const std::string& path) {
+    namespace h = oms::header;
+    const auto malformed = [&](std::size_t at, const std::string& detail) {
+        return InputError(InputErrorKind::MalformedHeader, path, InputLocation::byte(at), detail);
+    };
+    oms::UniformColumns uniform;
+    if (version >= 2) {
+        uniform.bits = header[h::kUniformColumns];
+    }
+    if ((uniform.bits & ~(oms::kUniformIntensityBit | oms::kUniformLasBit)) != 0) {
+        throw malformed(h::kUniformColumns,
+                        "expected uniform column bits within 0x03 (intensity 1, LAS column 2), "
+                        "found " +
+                            hex(uniform.bits, 2));
+    }
+    if (uniform.intensityUniform() && !attributes.has(Attribute::Intensity)) {
+        throw malformed(h::kUniformColumns,
+                        "the uniform column bits declare a uniform intensity, but the attribute "
+                        "bits have no intensity");
+    }
+    const std::size_t lasBytes = attributes.lasBytes();
+    if (uniform.lasUniform() && (lasBytes == 0 || lasBytes > oms::kMaxUniformLasBytes)) {
+        throw malformed(h::kUniformColumns,
+                        "the uniform column bits declare a uniform LAS column, but the attribute "
+                        "bits give a LAS column of " +
+                            std::to_string(lasBytes) + " bytes (1 to " +
+                            std::to_string(oms::kMaxUniformLasBytes) + " fit the header)");
+    }
+    // Zero: the byte after the bits (version 1: the bits too), an intensity or LAS record not
+    // declared, the bytes after the LAS record.
+    const std::size_t usedEnd = uniform.lasUniform()         ? h::kUniformLasRecord + lasBytes
+                                : uniform.intensityUniform() ? h::kUniformLasRecord
+                                                             : h::kUniformIntensity;
+    std::vector<std::pair<std::size_t, std::size_t>> zeros{
+        {version >= 2 ? h::kReserved0 : h::kUniformColumns, h::kCubeOrigin},
+        {usedEnd, h::kChecksum}};
+    if (uniform.lasUniform() && !uniform.intensityUniform()) {
+        zeros.emplace_back(h::kUniformIntensity, h::kUniformLasRecord);
+    }
+    for (const auto& [begin, end] : zeros) {
+        if (const auto at = firstNonZero(header, begin, end)) {
+            throw malformed(*at, "expected reserved header bytes " + std::to_string(begin) + "-" +
+                                     std::to_string(end - 1) + " to be zero, found " +
+                                     std::to_string(header[*at]) + " at byte " +
+                                     std::to_string(*at));
+        }
+    }
+    if (uniform.intensityUniform()) {
+        uniform.intensity = loadRaw<std::uint16_t>(header.data() + h::kUniformIntensity);
+    }
+    if (uniform.lasUniform()) {
+        uniform.lasRecord.assign(header.data() + h::kUniformLasRecord,
+                                 header.data() + h::kUniformLasRecord + lasBytes);
+    }
+    return uniform;
 }
 
 } // namespace
@@ -116,10 +191,11 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage, std::uint64_
                         ", found " + hex(endianness, 8));
     }
     const auto version = loadRaw<std::uint32_t>(header.data() + h::kVersion);
-    if (version != oms::kVersion) {
+    if (version < oms::kOldestVersion || version > oms::kVersion) {
         throw error(InputErrorKind::UnsupportedFeature, h::kVersion,
-                    "expected .oms format version " + std::to_string(oms::kVersion) +
-                        ", found version " + std::to_string(version));
+                    "expected .oms format version " + std::to_string(oms::kOldestVersion) + " to " +
+                        std::to_string(oms::kVersion) + ", found version " +
+                        std::to_string(version));
     }
     const auto storedHeaderChecksum = loadRaw<std::uint64_t>(header.data() + h::kChecksum);
     const std::uint64_t headerChecksum = oms::headerChecksum(header.data());
@@ -153,30 +229,16 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage, std::uint64_
                         std::to_string(extraBytes) +
                         " extra bytes: GPS time, NIR and extra bytes need the LAS bit (8)");
     }
-    m_layout = oms::RecordLayout::of(attributes);
+    const oms::UniformColumns uniform = parseUniformColumns(header, version, attributes, path);
+    m_layout = oms::storedRecordLayout(attributes, uniform);
     const auto recordBytes = loadRaw<std::uint16_t>(header.data() + h::kRecordBytes);
     if (recordBytes != m_layout.bytes) {
         throw error(InputErrorKind::MalformedHeader, h::kRecordBytes,
                     "expected a record size of " + std::to_string(m_layout.bytes) +
-                        " bytes for attribute bits " + hex(attributeBits, 2) + ", found " +
-                        std::to_string(recordBytes));
-    }
-    const auto reservedNonZero = [&](std::size_t begin, std::size_t end) -> std::size_t {
-        for (std::size_t at = begin; at < end; ++at) {
-            if (header[at] != 0) {
-                return at;
-            }
-        }
-        return 0;
-    };
-    for (const auto& [begin, end] :
-         {std::pair{h::kReserved0, h::kCubeOrigin}, std::pair{h::kReserved1, h::kChecksum}}) {
-        if (const std::size_t at = reservedNonZero(begin, end); at != 0) {
-            throw error(InputErrorKind::MalformedHeader, at,
-                        "expected reserved header bytes " + std::to_string(begin) + "-" +
-                            std::to_string(end - 1) + " to be zero, found " +
-                            std::to_string(header[at]) + " at byte " + std::to_string(at));
-        }
+                        " bytes for attribute bits " + hex(attributeBits, 2) +
+                        (uniform.bits != 0 ? " and uniform column bits " + hex(uniform.bits, 2)
+                                           : std::string()) +
+                        ", found " + std::to_string(recordBytes));
     }
     const glm::dvec3 origin = loadDvec3(header.data() + h::kCubeOrigin);
     const auto edge = loadRaw<double>(header.data() + h::kCubeEdge);
@@ -258,12 +320,18 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage, std::uint64_
     m_info.sortDepth = sortDepth;
     m_info.attributes = attributes;
     m_info.recordBytes = recordBytes;
+    m_info.uniform = uniform;
     m_info.fileBytes = fileBytes;
     m_info.cube = CubeTransform{origin, edge};
     m_info.sourceOffset = sourceOffset;
     m_cloud =
         makeSortedCloud(m_info.cube, sourceOffset, attributes, static_cast<std::size_t>(pointCount),
                         storage, memoryBudgetBytes, tempDir);
+    // A file-backed cloud keeps every column; read() then fills the uniform ones per point.
+    if (uniform.bits != 0 && !m_cloud->fileBacked()) {
+        m_cloud->setUniformColumns(uniform.intensityUniform() ? &uniform.intensity : nullptr,
+                                   uniform.lasUniform() ? uniform.lasRecord.data() : nullptr);
+    }
 }
 
 ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptions& options) {
@@ -277,7 +345,7 @@ ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptio
     const std::size_t recordBytes = m_layout.bytes;
     const std::size_t rangePoints =
         std::max<std::size_t>(1, std::min(options.batchPoints, kBlockBytes / recordBytes));
-    const AttributeSet attributes = m_info.attributes;
+    OmsRecordDecoder decoder(m_layout, m_info.attributes, m_info.uniform, m_info.path);
     oms::PayloadChecksum checksum;
     morton::Code previousCode = 0;
 
@@ -288,48 +356,12 @@ ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptio
             return summary;
         }
         const std::size_t end = std::min(count, begin + rangePoints);
-        const std::uint64_t blockStart = oms::kHeaderBytes + std::uint64_t{begin} * recordBytes;
         m_block.resize((end - begin) * recordBytes);
         m_stream.readExact(m_block.data(), m_block.size(),
                            "records " + std::to_string(begin) + " to " + std::to_string(end - 1));
         checksum.update(m_block.data(), m_block.size());
-        const std::uint8_t* record = m_block.data();
         const SortedCloud::StagedRange out = cloud.stage(end);
-        for (std::size_t i = begin; i < end; ++i, record += recordBytes) {
-            const auto p = loadRaw<glm::vec3>(record);
-            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-                throw InputError(InputErrorKind::MalformedValue, m_info.path,
-                                 InputLocation::byte(blockStart + (i - begin) * recordBytes),
-                                 "record " + std::to_string(i) +
-                                     ": expected a finite position in the unit cube");
-            }
-            const morton::Code code = morton::encodeUnit(p.x, p.y, p.z);
-            if (code < previousCode) {
-                const std::uint64_t at = blockStart + (i - begin) * recordBytes;
-                throw InputError(
-                    InputErrorKind::MalformedValue, m_info.path, InputLocation::byte(at),
-                    "record " + std::to_string(i) + " at byte " + std::to_string(at) +
-                        " is out of Morton order: the file is not sorted (its "
-                        "code " +
-                        hex(code) + " is below the previous record's " + hex(previousCode) + ")");
-            }
-            previousCode = code;
-            const std::size_t at = i - begin;
-            out.positions[at] = p;
-            if (attributes.has(Attribute::Normal)) {
-                out.normals[at] = loadRaw<glm::vec3>(record + m_layout.normalOffset);
-            }
-            if (attributes.has(Attribute::Color)) {
-                out.colors[at] = loadRaw<glm::u8vec3>(record + m_layout.colorOffset);
-            }
-            if (attributes.has(Attribute::Intensity)) {
-                out.intensities[at] = loadRaw<std::uint16_t>(record + m_layout.intensityOffset);
-            }
-            if (m_layout.lasBytes != 0) { // no LAS column: nowhere to copy to
-                std::memcpy(out.las.data() + at * m_layout.lasBytes, record + m_layout.lasOffset,
-                            m_layout.lasBytes);
-            }
-        }
+        previousCode = decoder.decode(m_block.data(), end - begin, begin, previousCode, out);
         cloud.publish(end);
         consumer(cloud, begin, end);
         summary.pointsDelivered = end;

@@ -24,6 +24,7 @@ struct OmsInfo {
     int sortDepth = 0;
     AttributeSet attributes;
     std::size_t recordBytes = 0;
+    oms::UniformColumns uniform; // the columns the header holds once (version 2)
     std::uint64_t fileBytes = 0;
     CubeTransform cube;           // unit cube -> source units
     glm::dvec3 sourceOffset{0.0}; // add to source units for the original coordinates
@@ -42,7 +43,8 @@ public:
     // shorter than header + count x record + footer), CountMismatch (longer, or the footer's
     // count differs), UnsupportedFeature (another version, sort depth, attribute bit, or a
     // big-endian file), MalformedHeader (header checksum, record size, non-finite cube, reserved
-    // bytes), NoPoints (count 0).
+    // bytes, uniform columns the attributes lack), NoPoints (count 0). Version 1 files load as
+    // they always did (no uniform columns).
     // `storage` is how cloud() keeps positions and colours. With a `memoryBudgetBytes`, an
     // exact cloud larger than half of it lives in an unnamed scratch file under `tempDir`
     // (empty: $TMPDIR or /tmp), kept out of memory beyond the budget (SortedCloud's
@@ -54,20 +56,21 @@ public:
     std::shared_ptr<SortedCloud> cloud() const { return m_cloud; }
 
     // Streams the records into cloud() front to back, in ranges of at most options.batchPoints
-    // points (and at most ~4 MiB of records): each range's codes are recomputed with
-    // morton::encodeUnit and checked for order, then published and handed to `consumer`, on
-    // the calling thread. After the last range the payload checksum is verified and the cloud
-    // marked complete. Call at most once. options.cancel is checked between ranges; a
-    // cancelled read returns with summary.cancelled set and the cloud left incomplete.
-    // Throws InputError: Truncated (the file shrank), MalformedValue (a non-finite position, a
-    // record out of Morton order, a payload checksum mismatch). Ranges handed out before a
-    // checksum mismatch were decoded from a damaged file: a caller must discard the cloud.
+    // points (and at most ~4 MiB of records): each range is decoded on every core, its codes
+    // recomputed with morton::encodeUnit and checked for order (the first bad record in the
+    // file is the one named), then published and handed to `consumer`, on the calling thread. After
+    // the last range the payload checksum is verified and the cloud marked complete. Call at most
+    // once. options.cancel is checked between ranges; a cancelled read returns with
+    // summary.cancelled set and the cloud left incomplete. Throws InputError: Truncated (the file
+    // shrank), MalformedValue (a non-finite position, a record out of Morton order, a payload
+    // checksum mismatch). Ranges handed out before a checksum mismatch were decoded from a damaged
+    // file: a caller must discard the cloud.
     ReadSummary read(const SortedRangeConsumer& consumer, const ReadOptions& options = {});
 
 private:
     FileStream m_stream;
     OmsInfo m_info;
-    oms::RecordLayout m_layout;
+    oms::RecordLayout m_layout; // of the records: without the uniform columns
     std::uint64_t m_expectedPayloadChecksum = 0;
     std::shared_ptr<SortedCloud> m_cloud;
     std::vector<std::uint8_t> m_block;

@@ -29,9 +29,12 @@ public:
     OmsWriter& operator=(const OmsWriter&) = delete;
 
     // Starts the file and writes its header; `pointCount` (>= 1) is the exact number of
-    // points the append() calls will deliver.
+    // points the append() calls will deliver. The columns `uniform` holds are written once, in
+    // the header (oms::uniformColumnsOf a cloud that keeps them so); every appended point must
+    // then hold that value.
     void open(const std::string& path, const CubeTransform& cube, const glm::dvec3& sourceOffset,
-              AttributeSet attributes, std::uint64_t pointCount);
+              AttributeSet attributes, std::uint64_t pointCount,
+              const oms::UniformColumns& uniform = {});
 
     // Appends [begin, end) of `cloud`, which must be published (end <= cloud.sortedEnd()) and
     // have the attributes given to open(). Ranges arrive in order: the first begins at 0 and
@@ -51,12 +54,17 @@ public:
 
 private:
     [[noreturn]] void fail(const std::string& what);
+    // Point `index`'s record; a uniform column is checked against the header's value instead.
+    void encodeRecord(std::uint64_t index, const glm::vec3& position, const glm::vec3* normal,
+                      const glm::u8vec3* color, const std::uint16_t* intensity,
+                      const std::uint8_t* las, std::uint8_t* record);
 
     std::string m_path;
     std::unique_ptr<AtomicFileWriter> m_file;
     std::unique_ptr<oms::PayloadChecksum> m_checksum;
-    oms::RecordLayout m_layout;
+    oms::RecordLayout m_layout; // without the uniform columns
     AttributeSet m_attributes;
+    oms::UniformColumns m_uniform;
     std::uint64_t m_pointCount = 0;
     std::uint64_t m_pointsWritten = 0;
     morton::Code m_lastCode = 0;
@@ -64,7 +72,7 @@ private:
 };
 
 // Writes points [0, pointCount) of `cloud` (pointCount <= cloud.sortedEnd(), >= 1) as a .oms
-// file. Throws OutputError.
+// file, its uniform columns once. Throws OutputError.
 void writeOms(const std::string& path, const SortedCloud& cloud, std::size_t pointCount);
 
 } // namespace omicron

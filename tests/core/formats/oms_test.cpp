@@ -10,6 +10,8 @@
 #include "sort/morton_sorter.hpp"
 #include "test_files.hpp"
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstring>
 #include <filesystem>
@@ -267,7 +269,7 @@ TEST(OmsFormat, WriterPutsEveryFieldAtItsDocumentedOffset) {
     const std::vector<std::uint8_t>& bytes = file.bytes;
     ASSERT_EQ(bytes.size(), 128u + 50u * 29u + 24u);
     EXPECT_EQ(std::memcmp(bytes.data(), "OMICRONS", 8), 0);
-    EXPECT_EQ(field<std::uint32_t>(bytes, 8), 1u);
+    EXPECT_EQ(field<std::uint32_t>(bytes, 8), 2u);
     EXPECT_EQ(bytes[12], 0x04);
     EXPECT_EQ(bytes[13], 0x03);
     EXPECT_EQ(bytes[14], 0x02);
@@ -322,6 +324,8 @@ TEST_P(OmsRoundTripAttributes, GeneratedCloudReadsBackBitExact) {
     const auto sorted = sortBatch(makeBatch(count, attributes, GetParam()));
     writeOms(path, *sorted, count);
 
+    // Random attributes: no column is uniform, every record holds them all.
+    EXPECT_EQ(oms::uniformColumnsOf(*sorted).bits, 0);
     const std::size_t recordBytes = oms::RecordLayout::of(attributes).bytes;
     EXPECT_EQ(std::filesystem::file_size(path), 128 + count * recordBytes + 24);
     EXPECT_EQ(fileCount(dir.path()), 1u);
@@ -330,7 +334,7 @@ TEST_P(OmsRoundTripAttributes, GeneratedCloudReadsBackBitExact) {
     options.batchPoints = 500;
     const ReadBack back = readOms(path, options);
     EXPECT_EQ(back.info.path, path);
-    EXPECT_EQ(back.info.version, 1u);
+    EXPECT_EQ(back.info.version, 2u);
     EXPECT_EQ(back.info.pointCount, count);
     EXPECT_EQ(back.info.sortDepth, 21);
     EXPECT_EQ(back.info.attributes, attributes);
@@ -685,10 +689,19 @@ TEST(OmsReaderErrors, ResealedHeaderFieldsAreValidated) {
          InputErrorKind::MalformedHeader, 26, "expected a record size of 29 bytes"},
         {"attributes without record size", [](auto& b) { b[25] = 0; },
          InputErrorKind::MalformedHeader, 26, "expected a record size of 12 bytes"},
-        {"reserved 0", [](auto& b) { b[30] = 1; }, InputErrorKind::MalformedHeader, 30,
-         "expected reserved header bytes 30-31 to be zero"},
-        {"reserved 1", [](auto& b) { b[100] = 7; }, InputErrorKind::MalformedHeader, 100,
+        {"reserved 0", [](auto& b) { b[31] = 1; }, InputErrorKind::MalformedHeader, 31,
+         "expected reserved header bytes 31-31 to be zero"},
+        {"no uniform LAS record", [](auto& b) { b[100] = 7; }, InputErrorKind::MalformedHeader, 100,
          "expected reserved header bytes 88-119 to be zero"},
+        {"unknown uniform column", [](auto& b) { b[30] = 4; }, InputErrorKind::MalformedHeader, 30,
+         "expected uniform column bits within 0x03 (intensity 1, LAS column 2), found 0x04"},
+        {"uniform LAS column without LAS", [](auto& b) { b[30] = 2; },
+         InputErrorKind::MalformedHeader, 30,
+         "declare a uniform LAS column, but the attribute bits give a LAS column of 0 bytes"},
+        {"uniform intensity, records keep it", [](auto& b) { b[30] = 1; },
+         InputErrorKind::MalformedHeader, 26,
+         "expected a record size of 27 bytes for attribute bits 0x07 and uniform column bits "
+         "0x01, found 29"},
         {"zero edge", [](auto& b) { setField(b, 56, 0.0); }, InputErrorKind::MalformedHeader, 56,
          "expected a finite cube edge > 0"},
         {"infinite origin",
@@ -729,11 +742,15 @@ TEST(OmsReaderErrors, BigEndianFileIsUnsupported) {
 
 TEST(OmsReaderErrors, NewerVersionIsUnsupported) {
     const SmallFile file;
-    std::vector<std::uint8_t> newer = file.bytes;
-    setField<std::uint32_t>(newer, 8, 2);
-    const std::string path = file.variant("v2.oms", newer);
-    const InputError error = expectReadError(path, InputErrorKind::UnsupportedFeature, 8);
-    EXPECT_TRUE(mentions(error, "expected .oms format version 1, found version 2")) << error.what();
+    for (const std::uint32_t version : {0u, 3u}) {
+        std::vector<std::uint8_t> other = file.bytes;
+        setField<std::uint32_t>(other, 8, version);
+        const std::string path = file.variant("other.oms", other);
+        const InputError error = expectReadError(path, InputErrorKind::UnsupportedFeature, 8);
+        EXPECT_TRUE(mentions(error, "expected .oms format version 1 to 2, found version " +
+                                        std::to_string(version)))
+            << error.what();
+    }
 }
 
 TEST(OmsReaderErrors, WrongMagicIsUnknownFormat) {
@@ -845,6 +862,14 @@ TEST(OmsWriter, InvalidUseThrowsAndLeavesNothingBehind) {
         "exceeds the 100 points declared at open()");
     expectOutputError(
         [&](OmsWriter& w) {
+            oms::UniformColumns uniform;
+            uniform.bits = oms::kUniformIntensityBit;
+            w.open(path, sorted->cube(), sorted->sourceOffset(), sorted->attributes(), 300,
+                   uniform);
+        },
+        "a uniform intensity for a cloud without intensities");
+    expectOutputError(
+        [&](OmsWriter& w) {
             open(w, 300);
             w.append(*sorted, 0, 299);
             w.finish();
@@ -879,6 +904,199 @@ TEST(OmsWriter, RefusesACloudThatIsNotInMortonOrder) {
             << error.what();
     }
     EXPECT_EQ(fileCount(dir.path()), 0u);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Version 2: a column every point shares is stored once, in the header.
+
+constexpr std::array<std::uint8_t, 8> kLasRecord{2, 0x11, 0, 7, 0xfe, 0xff, 0x34, 0x12};
+
+// A sorted cloud with colour, intensity and the LAS column, whose intensities are all 77
+// and/or whose LAS records are all kLasRecord.
+std::shared_ptr<const SortedCloud> cloudWithUniformColumns(std::size_t count, bool intensity,
+                                                           bool las) {
+    PointBatch batch =
+        makeBatch(count, AttributeSet(Attribute::Color) | Attribute::Intensity | Attribute::Las);
+    if (intensity) {
+        std::fill(batch.intensities.begin(), batch.intensities.end(), 77);
+    }
+    for (std::size_t i = 0; las && i < count; ++i) {
+        std::copy(kLasRecord.begin(), kLasRecord.end(), batch.las.begin() + i * kLasRecord.size());
+    }
+    return sortBatch(batch);
+}
+
+TEST(OmsUniformColumns, AreStoredOnceInTheHeaderAndReadBack) {
+    struct Case {
+        bool intensity, las;
+        std::uint8_t bits;
+        std::size_t recordBytes;
+    };
+    for (const Case c : {Case{true, true, 0x03, 15}, Case{true, false, 0x01, 23},
+                         Case{false, true, 0x02, 17}, Case{false, false, 0x00, 25}}) {
+        SCOPED_TRACE(std::to_string(c.bits));
+        test::TempDir dir;
+        const std::string path = dir.file("uniform.oms");
+        const std::size_t count = 9000;
+        const auto sorted = cloudWithUniformColumns(count, c.intensity, c.las);
+        ASSERT_EQ(sorted->uniformIntensities(), c.intensity);
+        ASSERT_EQ(sorted->uniformLasColumn(), c.las);
+        writeOms(path, *sorted, count);
+
+        const std::vector<std::uint8_t> bytes = test::readBytes(path);
+        ASSERT_EQ(bytes.size(), 128 + count * c.recordBytes + 24);
+        EXPECT_EQ(bytes[30], c.bits);
+        EXPECT_EQ(bytes[31], 0);
+        EXPECT_EQ(field<std::uint16_t>(bytes, 26), c.recordBytes);
+        EXPECT_EQ(field<std::uint16_t>(bytes, 88), c.intensity ? 77 : 0);
+        for (std::size_t at = 0; at < 30; ++at) {
+            EXPECT_EQ(bytes[90 + at], c.las && at < kLasRecord.size() ? kLasRecord[at] : 0)
+                << "byte " << 90 + at;
+        }
+        // Record 5: the position, the colour, then what is not uniform.
+        const std::size_t record = 128 + 5 * c.recordBytes;
+        EXPECT_EQ(field<glm::vec3>(bytes, record), sorted->positions()[5]);
+        EXPECT_EQ(field<glm::u8vec3>(bytes, record + 12), sorted->colors()[5]);
+        if (!c.intensity) {
+            EXPECT_EQ(field<std::uint16_t>(bytes, record + 15), sorted->intensities()[5]);
+        }
+        if (!c.las) {
+            EXPECT_EQ(std::memcmp(bytes.data() + record + (c.intensity ? 15 : 17),
+                                  sorted->lasRecord(5), 8),
+                      0);
+        }
+
+        ReadOptions options;
+        options.batchPoints = 5000; // two ranges, each of several grains
+        const ReadBack back = readOms(path, options);
+        EXPECT_EQ(back.info.uniform.bits, c.bits);
+        EXPECT_EQ(back.info.recordBytes, c.recordBytes);
+        EXPECT_EQ(back.cloud->uniformIntensities(), c.intensity);
+        EXPECT_EQ(back.cloud->uniformLasColumn(), c.las);
+        expectSameCloud(*sorted, *back.cloud);
+        expectRangesInOrder(back.log, *back.cloud, count);
+    }
+}
+
+TEST(OmsUniformColumns, AFileBackedCloudHoldsTheValuesAtEveryPoint) {
+    test::TempDir dir;
+    const std::string path = dir.file("uniform.oms");
+    const std::size_t count = 6000;
+    const auto sorted = cloudWithUniformColumns(count, true, true);
+    writeOms(path, *sorted, count);
+
+    // A budget far below the cloud: its arrays live in a scratch file, which keeps every column.
+    OmsReader reader(path, PointStorage::Exact, 4096, dir.path().string());
+    ASSERT_TRUE(reader.cloud()->fileBacked());
+    reader.read([](const SortedCloud&, std::size_t, std::size_t) {});
+    const SortedCloud& cloud = *reader.cloud();
+    EXPECT_FALSE(cloud.uniformIntensities());
+    EXPECT_FALSE(cloud.uniformLasColumn());
+    expectSameCloud(*sorted, cloud);
+}
+
+TEST(OmsUniformColumns, Version1FilesStillLoad) {
+    const SmallFile file;
+    std::vector<std::uint8_t> old = file.bytes;
+    setField<std::uint32_t>(old, 8, 1);
+    resealHeader(old);
+    const ReadBack back = readOms(file.variant("v1.oms", old));
+    EXPECT_EQ(back.info.version, 1u);
+    EXPECT_EQ(back.info.uniform.bits, 0);
+    expectSameCloud(*file.cloud, *back.cloud);
+
+    // In version 1 the uniform column bits are reserved.
+    old[30] = 1;
+    resealHeader(old);
+    const InputError error =
+        expectReadError(file.variant("v1-bits.oms", old), InputErrorKind::MalformedHeader, 30);
+    EXPECT_TRUE(mentions(error, "expected reserved header bytes 30-31 to be zero")) << error.what();
+}
+
+TEST(OmsWriter, RefusesAPointThatBreaksAUniformColumn) {
+    test::TempDir dir;
+    const std::string path = dir.file("out.oms");
+    const auto sorted = cloudWithUniformColumns(100, false, true);
+    PointBatch batch;
+    sorted->copyRange(0, 100, batch);
+    std::fill(batch.intensities.begin(), batch.intensities.end(), 5);
+    batch.intensities[63] = 6;
+    oms::UniformColumns uniform = oms::uniformColumnsOf(*sorted);
+    uniform.bits |= oms::kUniformIntensityBit;
+    uniform.intensity = 5;
+    OmsWriter writer;
+    writer.open(path, sorted->cube(), sorted->sourceOffset(), sorted->attributes(), 100, uniform);
+    try {
+        writer.append(batch);
+        ADD_FAILURE() << "expected an OutputError";
+    } catch (const OutputError& error) {
+        EXPECT_NE(std::string(error.what())
+                      .find("point 63 has intensity 6, not the uniform 5 given at open()"),
+                  std::string::npos)
+            << error.what();
+    }
+    EXPECT_EQ(fileCount(dir.path()), 0u);
+}
+
+// Records are decoded in grains on every core: whichever grain finds what, the error is the
+// file's first bad record, also where a grain's first record breaks the order.
+TEST(OmsReaderErrors, TheFirstBadRecordOfTheFileIsNamedWhicheverGrainFindsIt) {
+    const std::size_t count = 20000;
+    const SmallFile file(count, AttributeSet(Attribute::Color));
+    const std::size_t recordBytes = 15;
+    const auto recordAt = [&](std::size_t record) {
+        return 128 + record * recordBytes;
+    };
+    const auto edited = [&](const std::function<void(std::vector<std::uint8_t>&)>& edit) {
+        std::vector<std::uint8_t> bytes = file.bytes;
+        edit(bytes);
+        resealPayload(bytes);
+        return file.variant("edited.oms", bytes);
+    };
+    const auto nan = [&](std::vector<std::uint8_t>& bytes, std::size_t record) {
+        setField(bytes, recordAt(record), std::numeric_limits<float>::quiet_NaN());
+    };
+    // Record 0's position (the cube's corner, the lowest code) anywhere later breaks the order.
+    const auto lowest = [&](std::vector<std::uint8_t>& bytes, std::size_t record) {
+        std::memcpy(bytes.data() + recordAt(record), bytes.data() + recordAt(0), 12);
+    };
+    const auto expectOrderError = [&](const std::string& path, std::size_t record) {
+        const InputError error =
+            expectReadError(path, InputErrorKind::MalformedValue, recordAt(record));
+        EXPECT_TRUE(mentions(error, "record " + std::to_string(record) + " at byte " +
+                                        std::to_string(recordAt(record)) +
+                                        " is out of Morton order"))
+            << error.what();
+    };
+    const auto expectNonFinite = [&](const std::string& path, std::size_t record) {
+        const InputError error =
+            expectReadError(path, InputErrorKind::MalformedValue, recordAt(record));
+        EXPECT_TRUE(mentions(error, "record " + std::to_string(record) + ": expected a finite"))
+            << error.what();
+    };
+
+    // A grain's first record below the last of the grain before.
+    expectOrderError(edited([&](auto& b) { lowest(b, 4096); }), 4096);
+    expectOrderError(edited([&](auto& b) { lowest(b, 3 * 4096); }), 3 * 4096);
+    // A grain's first record not finite: that, not an order error.
+    expectNonFinite(edited([&](auto& b) { nan(b, 4096); }), 4096);
+    // Two bad records in different grains: the earlier one, whatever its kind.
+    expectOrderError(edited([&](auto& b) {
+                         lowest(b, 9000);
+                         nan(b, 15000);
+                     }),
+                     9000);
+    expectNonFinite(edited([&](auto& b) {
+                        nan(b, 5000);
+                        lowest(b, 15000);
+                    }),
+                    5000);
+    // Within a grain, the non-finite record before an order break.
+    expectNonFinite(edited([&](auto& b) {
+                        nan(b, 100);
+                        lowest(b, 101);
+                    }),
+                    100);
 }
 
 } // namespace
