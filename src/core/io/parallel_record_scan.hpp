@@ -20,8 +20,8 @@ struct RecordArray {
 };
 
 // Called on any scanning thread, for blocks in any order: records [firstIndex, firstIndex +
-// count) at `records`, followed by `paddingBytes` readable bytes.
-using ConcurrentBlockScan = std::function<void(const std::uint8_t* records, std::size_t count,
+// count) at `records` (the call's to change in place), followed by `paddingBytes` readable bytes.
+using ConcurrentBlockScan = std::function<void(std::uint8_t* records, std::size_t count,
                                                std::uint64_t firstIndex, std::uint64_t blockIndex)>;
 // Called once per block after its scan, one call at a time and in file order (block 0, 1, ...),
 // with the byte just past the block; false stops the scan (no later block is passed on).

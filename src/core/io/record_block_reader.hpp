@@ -18,7 +18,7 @@ namespace omicron {
 class RecordBlockReader {
 public:
     struct Block {
-        const std::uint8_t* records = nullptr;
+        std::uint8_t* records = nullptr; // the caller's to change in place until next()
         std::size_t count = 0;        // whole records in this block
         std::uint64_t firstIndex = 0; // index of records[0] in the array
     };

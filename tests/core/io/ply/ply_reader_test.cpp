@@ -107,6 +107,9 @@ private:
     bool m_bigEndian;
 };
 
+// A vertex property that makes records variable-size, so that the general code reads them.
+const std::string kEmptyList = "property list uchar int unused\n";
+
 std::string binaryHeader(std::size_t vertices,
                          const std::string& properties = "property float x\n"
                                                          "property float y\n"
@@ -514,7 +517,8 @@ TEST(PlyReaderLayout, ListsInsideTheVertexElement) {
 }
 
 TEST(PlyReaderLayout, BigEndianLittleEndianAndAsciiAgreeBitForBit) {
-    // The little-endian file takes the SIMD fast path, big-endian and ascii the general one.
+    // The binary files take the SIMD fast path (big-endian after a byte swap), ascii the general
+    // one.
     test::TempDir dir;
     const float values[][6] = {{1.25f, -3.5f, 1e-3f, 0.0f, 0.6f, 0.8f},
                                {1000.1f, 7.0f, -0.0f, 1.0f, 0.0f, 0.0f},
@@ -599,8 +603,10 @@ void expectTheSameRead(const ReadResult& fast, const ReadResult& general) {
 
 // A ushort or float intensity (CloudCompare's "scalar_Intensity"), beside float positions and
 // uchar colours, is read by the fast loops (and the bounds by the parallel pre-pass, over
-// several 1 MiB blocks) exactly as the general code reads it from the same values big-endian;
-// with adjacent x y z (SSE2) and apart (scalar).
+// several 1 MiB blocks) exactly as the general code reads it from the same values (records
+// with an empty list: variable-size, value by value); with adjacent x y z (SSE2) and apart
+// (scalar); little-endian, and big-endian (byte-swapped in place, then the same loops; the
+// points at the bounds go through the exact code, which must not swap them again).
 TEST(PlyReaderLayout, IntensityOnTheFastPathAgreesWithTheGeneralOne) {
     struct Layout {
         const char* name;
@@ -631,6 +637,7 @@ TEST(PlyReaderLayout, IntensityOnTheFastPathAgreesWithTheGeneralOne) {
         test::TempDir dir;
         PlyBytes little(binaryHeader(kPoints, layout.properties, "binary_little_endian"));
         PlyBytes big(binaryHeader(kPoints, layout.properties, "binary_big_endian"), true);
+        PlyBytes general(binaryHeader(kPoints, layout.properties + kEmptyList));
         for (std::size_t i = 0; i < kPoints; ++i) {
             // A NaN point now and then: skipped and counted by both paths.
             const float x = i % 9973 == 5 ? std::numeric_limits<float>::quiet_NaN()
@@ -642,7 +649,7 @@ TEST(PlyReaderLayout, IntensityOnTheFastPathAgreesWithTheGeneralOne) {
             const float floatIntensity = i % 101 == 3 ? std::numeric_limits<float>::quiet_NaN()
                                                       : 0.37f * static_cast<float>(i) - 1000.0f;
             const auto rgb = glm::u8vec3(i % 256, (i / 256) % 256, (3 * i) % 256);
-            for (PlyBytes* bytes : {&little, &big}) {
+            for (PlyBytes* bytes : {&little, &big, &general}) {
                 if (layout.apart) {
                     bytes->put(intensity).put(z).put(rgb.r).put(x).put(rgb.g).put(rgb.b).put(y);
                 } else {
@@ -655,12 +662,15 @@ TEST(PlyReaderLayout, IntensityOnTheFastPathAgreesWithTheGeneralOne) {
                 }
                 bytes->put(float(i));
             }
+            general.put(std::uint8_t(0));
         }
         little.write(dir.file("le.ply"));
         big.write(dir.file("be.ply"));
+        general.write(dir.file("general.ply"));
         const ReadResult fast = readAll(dir.file("le.ply"));
         ASSERT_TRUE(fast.info.attributes.has(Attribute::Intensity));
         EXPECT_EQ(fast.summary.skippedNonFinite, 26u); // i = 5, 9978, ... below 250,000
+        expectTheSameRead(fast, readAll(dir.file("general.ply")));
         expectTheSameRead(fast, readAll(dir.file("be.ply")));
         ASSERT_EQ(fast.points.intensities.size(), kPoints - 26);
         if (layout.floatIntensity) {
@@ -678,38 +688,43 @@ TEST(PlyReaderLayout, IntensityOnTheFastPathAgreesWithTheGeneralOne) {
 }
 
 // Double x y z (PDAL's PLY writer), with a "comment offset", float normals, uchar colours and
-// a ushort intensity: the double loops and the parallel pre-pass give what the general code
-// gives from the same values big-endian, bit for bit, NaN points skipped and counted alike.
+// a ushort intensity: the double loops and the parallel pre-pass, little- and big-endian, give
+// what the general code gives from the same values (records with an empty list), bit for bit,
+// NaN points skipped and counted alike.
 TEST(PlyReaderLayout, DoublePositionsOnTheFastPathAgreeWithTheGeneralOne) {
     const std::string properties =
         "property double x\nproperty double y\nproperty double z\nproperty float nx\n"
         "property float ny\nproperty float nz\nproperty uchar red\nproperty uchar green\n"
         "property uchar blue\nproperty ushort intensity\n";
-    const auto header = [&](const char* format) {
+    const auto header = [&](const char* format, const std::string& more = "") {
         return "ply\nformat " + std::string(format) +
-               " 1.0\ncomment offset 635000 848000 0\nelement vertex 150000\n" + properties +
+               " 1.0\ncomment offset 635000 848000 0\nelement vertex 150000\n" + properties + more +
                "end_header\n";
     };
     constexpr std::size_t kPoints = 150'000; // 45-byte records: 6.75 MB, seven pre-pass blocks
     test::TempDir dir;
     PlyBytes little(header("binary_little_endian"));
     PlyBytes big(header("binary_big_endian"), true);
+    PlyBytes general(header("binary_little_endian", kEmptyList));
     for (std::size_t i = 0; i < kPoints; ++i) {
         const double x = i % 7919 == 11 ? std::numeric_limits<double>::infinity()
                                         : 577.123456789 + 0.0731 * static_cast<double>(i % 40000);
         const double y = 882.5 + 1e-7 * static_cast<double>(i * i % 1000003);
         const double z = 406.25 + std::sin(1e-4 * static_cast<double>(i));
         const glm::vec3 normal(0.0f, 0.6f, i % 2 == 0 ? 0.8f : -0.8f);
-        for (PlyBytes* bytes : {&little, &big}) {
+        for (PlyBytes* bytes : {&little, &big, &general}) {
             bytes->put(x).put(y).put(z).put(normal.x).put(normal.y).put(normal.z);
             bytes->put(std::uint8_t(i % 251)).put(std::uint8_t(i % 13)).put(std::uint8_t(7));
             bytes->put(static_cast<std::uint16_t>(i % 60000));
         }
+        general.put(std::uint8_t(0));
     }
     little.write(dir.file("le.ply"));
     big.write(dir.file("be.ply"));
+    general.write(dir.file("general.ply"));
     const ReadResult fast = readAll(dir.file("le.ply"));
     EXPECT_EQ(fast.summary.skippedNonFinite, 19u); // i = 11, 7930, ... below 150,000
+    expectTheSameRead(fast, readAll(dir.file("general.ply")));
     expectTheSameRead(fast, readAll(dir.file("be.ply")));
     ASSERT_EQ(fast.points.size(), kPoints - 19);
     EXPECT_DOUBLE_EQ(fast.info.sourceBounds.min.x, 635577.123456789);
