@@ -87,17 +87,19 @@ INSTANTIATE_TEST_SUITE_P(Files, CliSortExport,
                                            "autzen_south.ply"),
                          test::FileParamName());
 
-// A LAS file whose intensities and LAS fields are all zero (converted from PLY) sorts into a
+// A LAS file whose intensities and LAS fields are all zero (tiled from a PLY) sorts into a
 // .oms that keeps them once in its header (version 2): the file is the records without them,
-// `info` names them, and building from it gives the same hierarchy as building from the LAS.
-// A scan whose fields vary keeps them in every record.
+// `info` names them, and building from it gives the same hierarchy as building from the LAS;
+// sorted or built beyond the memory budget, the same bytes. A scan whose fields vary keeps
+// them in every record.
 TEST(CliSort, UniformLasColumnsAreStoredOnce) {
     OMICRON_REQUIRE_SHARED_FILE(ply, "autzen_trim.ply");
     OMICRON_REQUIRE_SHARED_FILE(scan, "autzen_trim.las");
     test::TempDir dir;
-    const std::string las = dir.file("converted.las");
-    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"convert", ply, las}).exitCode, 0);
-    const std::string oms = dir.file("converted.oms");
+    // Tiled 4 times (0.44 M points): enough for a sort beyond the smallest budget, 4 MiB.
+    const std::string las = dir.file("tiled.las");
+    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"tile", ply, las, "--copies", "4"}).exitCode, 0);
+    const std::string oms = dir.file("tiled.oms");
     const auto sorted = runProcess(OMICRON_CLI_PATH, {"sort", las, oms});
     ASSERT_EQ(sorted.exitCode, 0) << sorted.err;
     const std::uint64_t points = openPointCloud(las)->info().pointCount;
@@ -117,6 +119,23 @@ TEST(CliSort, UniformLasColumnsAreStoredOnce) {
         return built.out.substr(from, built.out.find("time:") - from);
     };
     EXPECT_EQ(hierarchyOf(oms), hierarchyOf(las));
+
+    // A sort beyond its memory budget (runs on disk) finds them too: the same .oms bytes, and
+    // a build beyond it saves the same .omh bytes.
+    const std::string spilledOms = dir.file("spilled.oms");
+    const auto spilled =
+        runProcess(OMICRON_CLI_PATH, {"sort", las, spilledOms, "--memory-budget", "4M"});
+    ASSERT_EQ(spilled.exitCode, 0) << spilled.err;
+    EXPECT_NE(spilled.out.find("runs merged"), std::string::npos) << spilled.out;
+    EXPECT_EQ(test::readBytes(spilledOms), test::readBytes(oms));
+    const std::string omh = dir.file("in-memory.omh");
+    const std::string spilledOmh = dir.file("spilled.omh");
+    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"build", las, "--save", omh}).exitCode, 0);
+    const auto spilledBuild =
+        runProcess(OMICRON_CLI_PATH, {"build", las, "--memory-budget", "4M", "--save", spilledOmh});
+    ASSERT_EQ(spilledBuild.exitCode, 0) << spilledBuild.err;
+    EXPECT_NE(spilledBuild.out.find("sorted runs on disk"), std::string::npos) << spilledBuild.out;
+    EXPECT_EQ(test::readBytes(spilledOmh), test::readBytes(omh));
 
     const std::string scanOms = dir.file("scan.oms");
     ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"sort", scan, scanOms}).exitCode, 0);

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -327,8 +328,7 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage, std::uint64_
     m_cloud =
         makeSortedCloud(m_info.cube, sourceOffset, attributes, static_cast<std::size_t>(pointCount),
                         storage, memoryBudgetBytes, tempDir);
-    // A file-backed cloud keeps every column; read() then fills the uniform ones per point.
-    if (uniform.bits != 0 && !m_cloud->fileBacked()) {
+    if (uniform.bits != 0) {
         m_cloud->setUniformColumns(uniform.intensityUniform() ? &uniform.intensity : nullptr,
                                    uniform.lasUniform() ? uniform.lasRecord.data() : nullptr);
     }
@@ -345,7 +345,10 @@ ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptio
     const std::size_t recordBytes = m_layout.bytes;
     const std::size_t rangePoints =
         std::max<std::size_t>(1, std::min(options.batchPoints, kBlockBytes / recordBytes));
-    OmsRecordDecoder decoder(m_layout, m_info.attributes, m_info.uniform, m_info.path);
+    // The cloud stores the file's uniform columns once (the constructor set them).
+    assert(cloud.uniformIntensities() == m_info.uniform.intensityUniform() &&
+           cloud.uniformLasColumn() == m_info.uniform.lasUniform());
+    OmsRecordDecoder decoder(m_layout, m_info.attributes, m_info.path);
     oms::PayloadChecksum checksum;
     morton::Code previousCode = 0;
 

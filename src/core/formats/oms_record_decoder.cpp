@@ -26,8 +26,8 @@ std::string hex(std::uint64_t value) {
 } // namespace
 
 OmsRecordDecoder::OmsRecordDecoder(const oms::RecordLayout& layout, AttributeSet attributes,
-                                   const oms::UniformColumns& uniform, std::string path)
-    : m_layout(layout), m_attributes(attributes), m_uniform(uniform), m_path(std::move(path)) {}
+                                   std::string path)
+    : m_layout(layout), m_attributes(attributes), m_path(std::move(path)) {}
 
 morton::Code OmsRecordDecoder::decode(const std::uint8_t* block, std::size_t count,
                                       std::size_t first, morton::Code previousCode,
@@ -97,16 +97,12 @@ void OmsRecordDecoder::copyAttributes(const std::uint8_t* block, std::size_t beg
         if (m_attributes.has(Attribute::Color)) {
             out.colors[at] = loadRaw<glm::u8vec3>(record + m_layout.colorOffset);
         }
+        // A uniform column is stored once already: not staged (an empty span).
         if (!out.intensities.empty()) {
-            out.intensities[at] = m_uniform.intensityUniform()
-                                      ? m_uniform.intensity
-                                      : loadRaw<std::uint16_t>(record + m_layout.intensityOffset);
+            out.intensities[at] = loadRaw<std::uint16_t>(record + m_layout.intensityOffset);
         }
         if (!out.las.empty()) {
-            std::memcpy(out.las.data() + at * lasBytes,
-                        m_layout.lasBytes != 0 ? record + m_layout.lasOffset
-                                               : m_uniform.lasRecord.data(),
-                        lasBytes);
+            std::memcpy(out.las.data() + at * lasBytes, record + m_layout.lasOffset, lasBytes);
         }
     }
 }

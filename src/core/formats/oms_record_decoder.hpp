@@ -18,14 +18,13 @@ namespace omicron {
 
 class OmsRecordDecoder {
 public:
-    // Records of `layout` (without the columns `uniform` holds) with `attributes`, from the
-    // file `path` (for errors). `uniform` must outlive the decoder.
-    OmsRecordDecoder(const oms::RecordLayout& layout, AttributeSet attributes,
-                     const oms::UniformColumns& uniform, std::string path);
+    // Records of `layout` (without the file's uniform columns) with `attributes`, from the
+    // file `path` (for errors).
+    OmsRecordDecoder(const oms::RecordLayout& layout, AttributeSet attributes, std::string path);
 
     // Decodes records [0, count) of `block`, the file's records from `first` on, into `out`
-    // (a staged range of `count` points): a uniform column the cloud keeps once is not staged,
-    // one it keeps per point (a file-backed cloud) is filled with the header's value. Throws
+    // (a staged range of `count` points, with no span for the file's uniform columns: the
+    // cloud stores them once). Throws
     // InputError MalformedValue, at the record's byte, for the first record with a non-finite
     // position or a code below the record's before it (`previousCode` for the first). Returns
     // the last record's code.
@@ -56,7 +55,6 @@ private:
 
     oms::RecordLayout m_layout;
     AttributeSet m_attributes;
-    const oms::UniformColumns& m_uniform;
     std::string m_path;
     std::vector<GrainCheck> m_checks; // one per grain of the block being decoded
 };

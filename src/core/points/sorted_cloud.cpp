@@ -77,15 +77,25 @@ SortedCloud::InPlaceArrays SortedCloud::inPlaceArrays() {
 }
 
 void SortedCloud::setUniformColumns(const std::uint16_t* intensity, const std::uint8_t* lasRecord) {
-    assert(m_sortedEnd.load(std::memory_order_relaxed) == 0 && !fileBacked());
+    assert(m_sortedEnd.load(std::memory_order_relaxed) == 0);
+    // A file-backed array is written as the staged ranges are (its mapping reads it back);
+    // the rest of its reserved space stays unused.
     if (intensity != nullptr) {
         assert(m_intensities.size() != 0);
-        m_intensities.data()[0] = *intensity;
+        if (fileBacked()) {
+            m_intensities.writeAt(0, std::span(intensity, 1));
+        } else {
+            m_intensities.data()[0] = *intensity;
+        }
         m_intensityStride = 0;
     }
     if (lasRecord != nullptr) {
         assert(m_las.size() != 0);
-        std::memcpy(m_las.data(), lasRecord, m_attributes.lasBytes());
+        if (fileBacked()) {
+            m_las.writeAt(0, std::span(lasRecord, m_attributes.lasBytes()));
+        } else {
+            std::memcpy(m_las.data(), lasRecord, m_attributes.lasBytes());
+        }
         m_lasStride = 0;
     }
 }

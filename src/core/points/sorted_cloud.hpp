@@ -138,8 +138,8 @@ public:
     const std::uint8_t* lasRecord(std::size_t i) const { return m_las.data() + i * m_lasStride; }
     // Producer side, before the first stage(): the intensities and/or the LAS column are the
     // same for every point, `intensity` and `lasRecord` (lasBytes() bytes): each is stored
-    // once, and stage() hands out no span for it. Not for a file-backed cloud; a paged one's
-    // pager leaves the value resident. The cloud must have the attribute.
+    // once, and stage() hands out no span for it (a file-backed cloud keeps it in its file; a
+    // paged one's pager leaves the value resident). The cloud must have the attribute.
     void setUniformColumns(const std::uint16_t* intensity, const std::uint8_t* lasRecord);
     bool uniformIntensities() const { return m_intensities.size() != 0 && m_intensityStride == 0; }
     bool uniformLasColumn() const { return m_las.size() != 0 && m_lasStride == 0; }

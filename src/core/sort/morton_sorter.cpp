@@ -112,11 +112,11 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
     m_cloud->setLasExtraBytesDescriptors(info.lasExtraBytesDescriptors);
     m_cloud->setLasProjectionRecords(info.lasProjectionRecords);
     m_input.attributes = info.attributes;
+    m_uniform[kIntensities] = info.attributes.has(Attribute::Intensity);
+    m_uniform[kLas] = info.attributes.lasBytes() != 0;
     if (spills) {
         return;
     }
-    m_uniform[kIntensities] = info.attributes.has(Attribute::Intensity);
-    m_uniform[kLas] = info.attributes.lasBytes() != 0;
     m_bins.resize(kBins);
     m_blockLastBin.assign((capacity >> kReleaseBlockBits) + 1, 0);
     m_input.reserve(capacity);
@@ -176,6 +176,8 @@ void IncrementalMortonSorter::add(const PointBatch& batch, std::span<const morto
     m_pointsAdded += count;
     m_preview.add(batch, firstIndex);
     if (m_spiller) {
+        // The runs keep every column; a uniform one is stored once when they are merged.
+        checkUniformColumns(batch, firstIndex);
         m_spiller->add(batch, codes);
         return;
     }
@@ -208,7 +210,9 @@ void IncrementalMortonSorter::checkUniformColumns(const PointBatch& batch, std::
         if (!std::all_of(values.begin(), values.end(),
                          [&](std::uint16_t v) { return v == m_uniformIntensity; })) {
             m_uniform[kIntensities].store(false, std::memory_order_relaxed);
-            m_input.intensities.assign(firstIndex, m_uniformIntensity);
+            if (!m_spiller) {
+                m_input.intensities.assign(firstIndex, m_uniformIntensity);
+            }
         }
     }
     if (m_uniform[kLas].load(std::memory_order_relaxed)) {
@@ -221,7 +225,9 @@ void IncrementalMortonSorter::checkUniformColumns(const PointBatch& batch, std::
         const bool same =
             std::memcmp(records.data(), m_uniformLasRecord.data(), bytes) == 0 &&
             std::memcmp(records.data() + bytes, records.data(), records.size() - bytes) == 0;
-        if (!same) {
+        if (!same && m_spiller) {
+            m_uniform[kLas].store(false, std::memory_order_relaxed);
+        } else if (!same) {
             m_uniform[kLas].store(false, std::memory_order_relaxed);
             m_input.las.resize(firstIndex * bytes);
             for (std::size_t i = 0; i < firstIndex; ++i) {
@@ -399,17 +405,12 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
     }
 
     // A column uniform to the end is stored once, and not gathered.
-    const bool uniformIntensities = m_pointsAdded != 0 && m_uniform[kIntensities].load();
-    const bool uniformLas = m_pointsAdded != 0 && m_uniform[kLas].load();
-    if (uniformIntensities || uniformLas) {
-        m_cloud->setUniformColumns(uniformIntensities ? &m_uniformIntensity : nullptr,
-                                   uniformLas ? m_uniformLasRecord.data() : nullptr);
-        if (uniformIntensities) {
-            m_recyclers[kIntensities].reset();
-        }
-        if (uniformLas) {
-            m_recyclers[kLas].reset();
-        }
+    storeUniformColumns();
+    if (m_cloud->uniformIntensities()) {
+        m_recyclers[kIntensities].reset();
+    }
+    if (m_cloud->uniformLasColumn()) {
+        m_recyclers[kLas].reset();
     }
 
     // Written before they are read: not zero-filled (a pass over 18 MB for 24.2 M points).
@@ -550,7 +551,17 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
     return chunksDone;
 }
 
-// The merge feeds the sorted cloud batch by batch: staged, published, handed out.
+void IncrementalMortonSorter::storeUniformColumns() {
+    const bool uniformIntensities = m_pointsAdded != 0 && m_uniform[kIntensities].load();
+    const bool uniformLas = m_pointsAdded != 0 && m_uniform[kLas].load();
+    if (uniformIntensities || uniformLas) {
+        m_cloud->setUniformColumns(uniformIntensities ? &m_uniformIntensity : nullptr,
+                                   uniformLas ? m_uniformLasRecord.data() : nullptr);
+    }
+}
+
+// The merge feeds the sorted cloud batch by batch: staged, published, handed out (but for
+// the uniform columns emitSortedBatches() stored once).
 int IncrementalMortonSorter::mergeAndEmit(const SortedRangeConsumer& consumer) {
     const auto start = Clock::now();
     SortedCloud& cloud = *m_cloud;
@@ -561,8 +572,13 @@ int IncrementalMortonSorter::mergeAndEmit(const SortedRangeConsumer& consumer) {
         std::copy(sorted.positions.begin(), sorted.positions.end(), out.positions.begin());
         std::copy(sorted.normals.begin(), sorted.normals.end(), out.normals.begin());
         std::copy(sorted.colors.begin(), sorted.colors.end(), out.colors.begin());
-        std::copy(sorted.intensities.begin(), sorted.intensities.end(), out.intensities.begin());
-        std::copy(sorted.las.begin(), sorted.las.end(), out.las.begin());
+        if (!out.intensities.empty()) {
+            std::copy(sorted.intensities.begin(), sorted.intensities.end(),
+                      out.intensities.begin());
+        }
+        if (!out.las.empty()) {
+            std::copy(sorted.las.begin(), sorted.las.end(), out.las.begin());
+        }
         cloud.publish(end + n);
         if (m_firstRangeSeconds < 0.0) {
             m_firstRangeSeconds = secondsSince(start);
@@ -581,6 +597,9 @@ void IncrementalMortonSorter::emitSortedBatches(const SortedBatchConsumer& consu
         throw std::logic_error("emitSortedBatches() needs a spilling sort");
     }
     m_spiller->finish();
+    // The sorted cloud (filled by mergeAndEmit(), or only asked for its cube and uniform
+    // columns by a writer) keeps them once.
+    storeUniformColumns();
     // A quarter of the budget for the runs' read buffers, at least 64 KiB a run.
     const std::size_t runs = m_spiller->runs().size();
     const std::size_t bufferBytes = static_cast<std::size_t>(std::max<std::uint64_t>(

@@ -172,17 +172,19 @@ private:
     };
     std::array<ArrivalColumn, kColumns> m_arrivalColumns;
     // Per column, true while every point added so far has the first point's value (only ever
-    // for the intensities and the LAS column, of an in-memory sort): such a column's arrival
-    // array stays empty and untouched, and the sorted cloud stores the value once. Many LAS
-    // files hold zeros in most fields (converted or photogrammetric clouds: no GPS time,
+    // for the intensities and the LAS column): such a column's arrival array stays empty and
+    // untouched (a spilling sort's runs keep it), and the sorted cloud stores the value once.
+    // Many LAS files hold zeros in most fields (converted or photogrammetric clouds: no GPS time,
     // intensity or returns). Atomic: populateAhead() reads them on another thread.
     std::array<std::atomic<bool>, kColumns> m_uniform{};
     std::uint16_t m_uniformIntensity = 0;
     std::vector<std::uint8_t> m_uniformLasRecord;
     // Keeps the uniform columns uniform while `batch` (the points from `firstIndex` on) agrees;
-    // else fills the column's arrival array up to `firstIndex` with its value, and it is an
-    // ordinary column from then on.
+    // else (in memory) fills the column's arrival array up to `firstIndex` with its value, and
+    // it is an ordinary column from then on.
     void checkUniformColumns(const PointBatch& batch, std::size_t firstIndex);
+    // The columns uniform to the end go to the sorted cloud once, before its first range.
+    void storeUniformColumns();
     // Appends `batch` to the arrival arrays, but for the uniform columns.
     void appendArrival(const PointBatch& batch);
     std::size_t m_arrivalCapacity = 0; // points the arrival arrays have room for

@@ -51,10 +51,13 @@ Input makeInput(std::size_t intensityChangesAt, std::size_t lasChangesAt) {
 
 // Sorts `input` fed in batches of kFeedBatch, with another thread faulting arrival pages in
 // ahead (as the reader does), and checks every point's attributes against its input point.
-std::shared_ptr<const SortedCloud> sortAndCheck(const Input& input) {
+// `budget`: the sort's memory budget (0: the default, in memory).
+std::shared_ptr<const SortedCloud> sortAndCheck(const Input& input, std::uint64_t budget = 0) {
     SortOptions options;
     options.chunks = 4;
+    options.memoryBudgetBytes = budget;
     IncrementalMortonSorter sorter(input.info, options);
+    EXPECT_EQ(sorter.spills(), budget != 0);
     std::atomic<std::size_t> added{0};
     std::atomic<bool> reading{true};
     std::thread populator([&] {
@@ -128,22 +131,22 @@ TEST(UniformColumns, AColumnThatChangesAnywhereKeepsEveryValue) {
     }
 }
 
-TEST(UniformColumns, ASpillingSortKeepsOrdinaryColumns) {
-    const Input input = makeInput(kPoints, kPoints);
-    SortOptions options;
-    options.memoryBudgetBytes = 256 * 1024; // far below the in-memory sort: runs on disk
-    IncrementalMortonSorter sorter(input.info, options);
-    ASSERT_TRUE(sorter.spills());
-    sorter.add(input.points);
-    sorter.sortAndEmit([](const SortedCloud&, std::size_t, std::size_t) {});
-    const auto sorted = sorter.cloud();
-    ASSERT_EQ(sorted->sortedEnd(), kPoints);
-    EXPECT_FALSE(sorted->uniformIntensities());
-    EXPECT_FALSE(sorted->uniformLasColumn());
-    for (std::size_t i = 0; i < kPoints; ++i) {
-        ASSERT_EQ(sorted->intensities()[i], 7);
-        ASSERT_EQ(sorted->lasRecord(i)[15], 15 * 3 + 1);
-    }
+// A sort larger than its budget (runs on disk, merged into a sorted cloud in a scratch file)
+// finds them too: the runs keep every column, the merged cloud stores a uniform one once.
+TEST(UniformColumns, ASpillingSortStoresThemOnceToo) {
+    constexpr std::uint64_t kBudget = 256 * 1024; // far below the in-memory sort
+    const auto uniform = sortAndCheck(makeInput(kPoints, kPoints), kBudget);
+    EXPECT_TRUE(uniform->fileBacked());
+    EXPECT_TRUE(uniform->uniformIntensities());
+    EXPECT_TRUE(uniform->uniformLasColumn());
+
+    // Changes in a later run, and mid-batch in the first.
+    const auto intensitiesChange = sortAndCheck(makeInput(kPoints - 1, kPoints), kBudget);
+    EXPECT_FALSE(intensitiesChange->uniformIntensities());
+    EXPECT_TRUE(intensitiesChange->uniformLasColumn());
+    const auto lasChanges = sortAndCheck(makeInput(kPoints, 17), kBudget);
+    EXPECT_TRUE(lasChanges->uniformIntensities());
+    EXPECT_FALSE(lasChanges->uniformLasColumn());
 }
 
 } // namespace
