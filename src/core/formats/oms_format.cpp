@@ -27,16 +27,7 @@ UniformColumns uniformColumnsOf(const SortedCloud& cloud) {
 }
 
 RecordLayout storedRecordLayout(AttributeSet attributes, const UniformColumns& uniform) {
-    RecordLayout layout = RecordLayout::of(attributes);
-    if (uniform.intensityUniform() && attributes.has(Attribute::Intensity)) {
-        layout.lasOffset -= sizeof(std::uint16_t);
-        layout.bytes -= sizeof(std::uint16_t);
-    }
-    if (uniform.lasUniform()) {
-        layout.bytes -= layout.lasBytes;
-        layout.lasBytes = 0;
-    }
-    return layout;
+    return RecordLayout::of(attributes).without(uniform.intensityUniform(), uniform.lasUniform());
 }
 
 struct PayloadChecksum::State {

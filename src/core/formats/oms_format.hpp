@@ -102,7 +102,6 @@ struct UniformColumns {
 UniformColumns uniformColumnsOf(const SortedCloud& cloud);
 
 // A record of `attributes` without the columns `uniform` holds: the layout of a file's records.
-// Its intensityOffset and lasOffset mean nothing for a uniform column (lasBytes is then 0).
 RecordLayout storedRecordLayout(AttributeSet attributes, const UniformColumns& uniform);
 
 // XXH64 (seed 0) of a header's first header::kChecksum bytes.

@@ -176,9 +176,11 @@ void IncrementalMortonSorter::add(const PointBatch& batch, std::span<const morto
     m_pointsAdded += count;
     m_preview.add(batch, firstIndex);
     if (m_spiller) {
-        // The runs keep every column; a uniform one is stored once when they are merged.
+        // A run leaves out the columns uniform so far; the merge puts their value back.
         checkUniformColumns(batch, firstIndex);
-        m_spiller->add(batch, codes);
+        m_spiller->add(batch, codes,
+                       {m_uniform[kIntensities].load(std::memory_order_relaxed),
+                        m_uniform[kLas].load(std::memory_order_relaxed)});
         return;
     }
     // The counting pass and first distribution, done while the data arrives.
@@ -604,7 +606,9 @@ void IncrementalMortonSorter::emitSortedBatches(const SortedBatchConsumer& consu
     const std::size_t runs = m_spiller->runs().size();
     const std::size_t bufferBytes = static_cast<std::size_t>(std::max<std::uint64_t>(
         m_options.memoryBudgetBytes / 4, std::uint64_t{runs} * (std::uint64_t{1} << 16)));
-    RunMerger merger(m_spiller->runs(), m_info.attributes, bufferBytes);
+    // Runs spilled while a column was uniform left it out: the merge gives it the value.
+    RunMerger merger(m_spiller->runs(), bufferBytes,
+                     LeftOutColumns{m_uniformIntensity, m_uniformLasRecord.data()});
     PointBatch sorted;
     sorted.attributes = m_info.attributes;
     sorted.reserve(m_options.batchPoints);

@@ -5,14 +5,15 @@
 
 namespace omicron {
 
-RunMerger::RunMerger(const std::vector<SortedRun>& runs, AttributeSet attributes,
-                     std::size_t bufferBytes)
-    : m_layout(PointRecordLayout::of(attributes)) {
+RunMerger::RunMerger(const std::vector<SortedRun>& runs, std::size_t bufferBytes,
+                     const LeftOutColumns& leftOut)
+    : m_leftOut(leftOut) {
     const std::size_t perRun = bufferBytes / std::max<std::size_t>(runs.size(), 1);
-    m_recordsPerBuffer = std::max<std::size_t>(1, perRun / m_layout.bytes);
     m_cursors.resize(runs.size());
     for (std::size_t r = 0; r < runs.size(); ++r) {
         m_cursors[r].file = runs[r].file.get();
+        m_cursors[r].layout = runs[r].layout;
+        m_cursors[r].recordsPerBuffer = std::max<std::size_t>(1, perRun / runs[r].layout.bytes);
         m_cursors[r].points = runs[r].points;
         m_pointsLeft += runs[r].points;
         if (refill(m_cursors[r])) {
@@ -28,16 +29,17 @@ bool RunMerger::refill(Cursor& cursor) {
     if (cursor.nextToLoad == cursor.points) {
         return false;
     }
+    const std::size_t recordBytes = cursor.layout.bytes;
     const std::size_t count = static_cast<std::size_t>(
-        std::min<std::uint64_t>(m_recordsPerBuffer, cursor.points - cursor.nextToLoad));
-    cursor.records.resize(count * m_layout.bytes);
-    cursor.file->read(cursor.nextToLoad * m_layout.bytes, cursor.records.data(),
+        std::min<std::uint64_t>(cursor.recordsPerBuffer, cursor.points - cursor.nextToLoad));
+    cursor.records.resize(count * recordBytes);
+    cursor.file->read(cursor.nextToLoad * recordBytes, cursor.records.data(),
                       cursor.records.size());
     // The code of a stored float position is bit for bit the one the run was sorted by.
     cursor.codes.resize(count);
     for (std::size_t i = 0; i < count; ++i) {
         float xyz[3];
-        std::memcpy(xyz, cursor.records.data() + i * m_layout.bytes, sizeof xyz);
+        std::memcpy(xyz, cursor.records.data() + i * recordBytes, sizeof xyz);
         cursor.codes[i] = morton::encodeUnit(xyz[0], xyz[1], xyz[2]);
     }
     cursor.nextToLoad += count;
@@ -48,8 +50,8 @@ bool RunMerger::refill(Cursor& cursor) {
             m_readAhead.get(); // long done: another run's buffer was merged meanwhile
         }
         const ScratchFile* file = cursor.file;
-        const std::uint64_t offset = cursor.nextToLoad * m_layout.bytes;
-        const std::uint64_t bytes = std::uint64_t{m_recordsPerBuffer} * m_layout.bytes;
+        const std::uint64_t offset = cursor.nextToLoad * recordBytes;
+        const std::uint64_t bytes = std::uint64_t{cursor.recordsPerBuffer} * recordBytes;
         m_readAhead = std::async(std::launch::async,
                                  [file, offset, bytes] { file->willRead(offset, bytes); });
     }
@@ -85,7 +87,8 @@ std::size_t RunMerger::next(PointBatch& out, std::size_t maxPoints) {
     std::size_t emitted = 0;
     while (emitted < maxPoints && !m_heap.empty()) {
         Cursor& top = m_cursors[m_heap.front()];
-        decodePointRecord(m_layout, top.records.data() + top.at * m_layout.bytes, out);
+        decodePointRecord(top.layout, top.records.data() + top.at * top.layout.bytes, out,
+                          m_leftOut);
         ++emitted;
         if (++top.at == top.buffered && !refill(top)) {
             m_heap.front() = m_heap.back();

@@ -19,11 +19,15 @@ namespace omicron {
 
 class RunMerger {
 public:
-    // `bufferBytes` is shared by the runs' read buffers (at least one record each).
-    RunMerger(const std::vector<SortedRun>& runs, AttributeSet attributes, std::size_t bufferBytes);
+    // `bufferBytes` is shared by the runs' read buffers (at least one record each). A run that
+    // leaves a column out (RunSpiller) gives each of its points `leftOut`'s value (its
+    // lasRecord must outlive the merger).
+    RunMerger(const std::vector<SortedRun>& runs, std::size_t bufferBytes,
+              const LeftOutColumns& leftOut = {});
 
     // Appends the next (at most `maxPoints`) points of the stream to `out` (whose attributes
-    // must be the runs') and returns how many; 0 once the stream is over.
+    // must be the cloud's the runs were spilled from) and returns how many; 0 once the stream
+    // is over.
     std::size_t next(PointBatch& out, std::size_t maxPoints);
 
     std::uint64_t pointsLeft() const { return m_pointsLeft; }
@@ -31,6 +35,8 @@ public:
 private:
     struct Cursor {
         const ScratchFile* file = nullptr;
+        PointRecordLayout layout; // of the run's records
+        std::size_t recordsPerBuffer = 1;
         std::uint64_t points = 0;     // in the run
         std::uint64_t nextToLoad = 0; // first point not in the buffer yet
         std::vector<std::uint8_t> records;
@@ -43,8 +49,7 @@ private:
     bool lessThan(std::uint32_t a, std::uint32_t b) const; // heap order: (code, run)
     void siftDown(std::size_t slot);
 
-    PointRecordLayout m_layout;
-    std::size_t m_recordsPerBuffer;
+    LeftOutColumns m_leftOut;
     std::vector<Cursor> m_cursors;
     std::vector<std::uint32_t> m_heap; // cursor indices, smallest (code, run) on top
     std::uint64_t m_pointsLeft = 0;

@@ -48,7 +48,9 @@ RunSpiller::RunSpiller(const std::string& tempParent, AttributeSet attributes,
     m_spilledCodes.reserve(m_runPoints);
 }
 
-void RunSpiller::add(const PointBatch& batch, std::span<const morton::Code> codes) {
+void RunSpiller::add(const PointBatch& batch, std::span<const morton::Code> codes,
+                     UniformSoFar uniform) {
+    m_uniform = uniform;
     for (std::size_t first = 0; first < batch.size();) {
         const std::size_t room = m_runPoints - m_buffer.size();
         const std::size_t take = std::min(room, batch.size() - first);
@@ -56,14 +58,14 @@ void RunSpiller::add(const PointBatch& batch, std::span<const morton::Code> code
         m_codes.insert(m_codes.end(), codes.begin() + first, codes.begin() + first + take);
         first += take;
         if (m_buffer.size() == m_runPoints) {
-            startSpill();
+            startSpill(m_layout.without(uniform.intensity, uniform.las));
         }
     }
 }
 
 void RunSpiller::finish() {
     if (!m_buffer.empty()) {
-        startSpill();
+        startSpill(m_layout.without(m_uniform.intensity, m_uniform.las));
     }
     collectSpill();
     // The buffers' memory goes back before the merge needs its own.
@@ -83,17 +85,18 @@ void RunSpiller::collectSpill() {
     }
 }
 
-void RunSpiller::startSpill() {
+void RunSpiller::startSpill(const PointRecordLayout& layout) {
     collectSpill(); // the other buffer is free again
     std::swap(m_buffer, m_spilled);
     std::swap(m_codes, m_spilledCodes);
     m_buffer.clear();
     m_codes.clear();
-    m_spilling = std::async(std::launch::async,
-                            [this, index = m_runsStarted++] { return writeRun(index); });
+    m_spilling = std::async(std::launch::async, [this, index = m_runsStarted++, layout] {
+        return writeRun(index, layout);
+    });
 }
 
-SortedRun RunSpiller::writeRun(std::size_t index) {
+SortedRun RunSpiller::writeRun(std::size_t index, PointRecordLayout layout) {
     const std::size_t n = m_spilled.size();
     // Stable: equal codes keep their input order, which the merge then keeps across runs.
     std::vector<std::uint32_t> order(n), orderScratch(n);
@@ -107,16 +110,17 @@ SortedRun RunSpiller::writeRun(std::size_t index) {
     SortedRun run;
     run.file = std::make_unique<ScratchFile>(m_folder, "run-" + std::to_string(index));
     run.points = n;
-    const std::size_t recordsPerBlock = std::max<std::size_t>(1, kWriteBlockBytes / m_layout.bytes);
+    run.layout = layout;
+    const std::size_t recordsPerBlock = std::max<std::size_t>(1, kWriteBlockBytes / layout.bytes);
     std::vector<std::uint8_t> block;
     for (std::size_t first = 0; first < n; first += recordsPerBlock) {
         const std::size_t count = std::min(recordsPerBlock, n - first);
-        block.resize(count * m_layout.bytes);
+        block.resize(count * layout.bytes);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 16384),
                           [&](const tbb::blocked_range<std::size_t>& range) {
                               for (std::size_t i = range.begin(); i < range.end(); ++i) {
-                                  encodePointRecord(m_layout, m_spilled, order[first + i],
-                                                    block.data() + i * m_layout.bytes);
+                                  encodePointRecord(layout, m_spilled, order[first + i],
+                                                    block.data() + i * layout.bytes);
                               }
                           });
         run.file->write(block.data(), block.size());

@@ -4,6 +4,10 @@
 // cut in input order, so merging them with ties taken in run order (RunMerger) gives exactly
 // the stable Morton order an in-memory sort of the whole input gives.
 //
+// A run leaves out the columns uniform when it is spilled (every point so far holds the first
+// point's intensity, or LAS record): its records are smaller, and the merge puts the value
+// back (RunMerger's LeftOutColumns).
+//
 // Two buffers: a full one is sorted and written on a thread of its own while the reading
 // thread fills the other. Sorting and writing a run took three quarters of the read phase,
 // with the reader waiting (200 M points under a 1 GiB budget: 4.8 of 6.4 s).
@@ -27,6 +31,13 @@ namespace omicron {
 struct SortedRun {
     std::unique_ptr<ScratchFile> file;
     std::uint64_t points = 0;
+    PointRecordLayout layout; // of its records: the attributes' less its left-out columns
+};
+
+// The columns every point added so far shares (the sorter's uniform columns).
+struct UniformSoFar {
+    bool intensity = false;
+    bool las = false;
 };
 
 class RunSpiller {
@@ -42,8 +53,10 @@ public:
                std::uint64_t totalPoints);
 
     // Reading thread: buffers `batch` (codes[i] is the code of point i), spilling every full
-    // run. Throws what writing the previous run threw (OutputError: a full disk).
-    void add(const PointBatch& batch, std::span<const morton::Code> codes);
+    // run without the columns `uniform` says every point added so far, `batch` included,
+    // shares. Throws what writing the previous run threw (OutputError: a full disk).
+    void add(const PointBatch& batch, std::span<const morton::Code> codes,
+             UniformSoFar uniform = {});
     // Spills what is buffered, waits for every run to be written and frees the buffers; call
     // once, after the last add().
     void finish();
@@ -59,16 +72,17 @@ public:
 
 private:
     // Waits for the run being written (rethrowing its error) and hands the full buffer to a
-    // thread that sorts and writes it.
-    void startSpill();
+    // thread that sorts and writes it with `layout`.
+    void startSpill(const PointRecordLayout& layout);
     // Waits for the run being written, if any, and adds it to m_runs; rethrows its error.
     void collectSpill();
     // The spilling thread: sorts m_spilled by m_spilledCodes and writes it as run `index`.
-    SortedRun writeRun(std::size_t index);
+    SortedRun writeRun(std::size_t index, PointRecordLayout layout);
 
     ScratchFolder m_folder;
-    PointRecordLayout m_layout;
+    PointRecordLayout m_layout; // every column
     std::size_t m_runPoints;
+    UniformSoFar m_uniform;            // as of the last add()
     PointBatch m_buffer;               // being filled (reading thread)
     std::vector<morton::Code> m_codes; // their codes
     PointBatch m_spilled;              // being sorted and written (the spilling thread)

@@ -2,7 +2,10 @@
 // copied into the sorter's arrival arrays and are stored once in the sorted cloud; a column that
 // stops being uniform at any point (first batch, a batch boundary, mid-batch, the last point)
 // becomes an ordinary one, and every point keeps its own value either way.
+#include "points/morton_batch.hpp"
 #include "sort/morton_sorter.hpp"
+#include "sort/run_merger.hpp"
+#include "sort/run_spiller.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -147,6 +150,54 @@ TEST(UniformColumns, ASpillingSortStoresThemOnceToo) {
     const auto lasChanges = sortAndCheck(makeInput(kPoints, 17), kBudget);
     EXPECT_TRUE(lasChanges->uniformIntensities());
     EXPECT_FALSE(lasChanges->uniformLasColumn());
+}
+
+// The runs themselves: one spilled while a column is uniform leaves it out (smaller records),
+// and the merge gives every point of it the value back, point for point the input's.
+TEST(UniformColumns, RunsLeaveOutTheColumnsUniformWhenTheyAreSpilled) {
+    const Input input = makeInput(kPoints, kPoints / 2); // the LAS column changes half-way
+    const AttributeSet attributes = input.info.attributes;
+    const std::size_t lasBytes = attributes.lasBytes();
+    const std::size_t fullBytes = PointRecordLayout::of(attributes).bytes;
+    std::vector<morton::Code> codes(kPoints);
+    morton::encodeUnitBatch(input.points.positions, codes);
+    std::vector<SortedRun> runs;
+    {
+        RunSpiller spiller("", attributes, 10000, kPoints);
+        for (std::size_t begin = 0; begin < kPoints; begin += kFeedBatch) {
+            const std::size_t end = std::min(kPoints, begin + kFeedBatch);
+            PointBatch batch;
+            batch.attributes = attributes;
+            batch.appendRange(input.points, begin, end);
+            spiller.add(batch, std::span(codes).subspan(begin, end - begin),
+                        {true, end <= kPoints / 2});
+        }
+        spiller.finish();
+        ASSERT_EQ(spiller.runs().size(), 5u);
+        for (std::size_t r = 0; r < 5; ++r) {
+            SCOPED_TRACE(r);
+            const SortedRun& run = spiller.runs()[r];
+            // Runs 0 and 1 were spilled before the LAS column changed (point 25,000).
+            const std::size_t expected = fullBytes - 2 - (r < 2 ? lasBytes : 0);
+            EXPECT_EQ(run.layout.bytes, expected);
+            EXPECT_EQ(run.file->size(), run.points * expected);
+        }
+
+        RunMerger merger(spiller.runs(), 1 << 20,
+                         LeftOutColumns{7, input.points.las.data()}); // point 0's LAS record
+        PointBatch merged;
+        merged.attributes = attributes;
+        ASSERT_EQ(merger.next(merged, kPoints + 1), kPoints);
+        for (std::size_t i = 0; i < kPoints; ++i) {
+            const auto from = static_cast<std::size_t>(merged.normals[i].z);
+            ASSERT_EQ(merged.positions[i], input.points.positions[from]) << i;
+            ASSERT_EQ(merged.intensities[i], 7) << i;
+            ASSERT_EQ(std::memcmp(merged.las.data() + i * lasBytes,
+                                  input.points.las.data() + from * lasBytes, lasBytes),
+                      0)
+                << i;
+        }
+    }
 }
 
 } // namespace
