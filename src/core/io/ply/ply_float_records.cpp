@@ -131,11 +131,20 @@ struct AttributeCopy {
 };
 
 using Intensity = FloatRecordLayout::Intensity;
+using Color = FloatRecordLayout::Color;
+
+// A ushort colour channel as 8 bits: plyColorChannel's round(v / 257) in integers (v / 257 is
+// never within 1/514 of a half, so the two agree for every v).
+inline std::uint8_t colorByte(const std::uint8_t* at) {
+    std::uint16_t v;
+    std::memcpy(&v, at, sizeof v);
+    return static_cast<std::uint8_t>((2u * v + 257u) / 514u);
+}
 
 // The optional float normal, uchar colour and ushort or float intensity of record r, shared by both
 // conversions. Only present arrays are indexed: arithmetic on an absent array's null pointer is
 // undefined behaviour (found by fuzz_ply under UBSan).
-template <bool kNormals, bool kColors, Intensity kIntensity>
+template <bool kNormals, Color kColor, Intensity kIntensity>
 inline void copyOptionalAttributes(const std::uint8_t* record, std::size_t r,
                                    const AttributeCopy& copy) {
     if constexpr (kNormals) {
@@ -143,9 +152,13 @@ inline void copyOptionalAttributes(const std::uint8_t* record, std::size_t r,
             glm::vec3(loadFloat(record + copy.normalAt[0]), loadFloat(record + copy.normalAt[1]),
                       loadFloat(record + copy.normalAt[2]));
     }
-    if constexpr (kColors) {
+    if constexpr (kColor == Color::UChar) {
         copy.colors[r] =
             glm::u8vec3(record[copy.colorAt[0]], record[copy.colorAt[1]], record[copy.colorAt[2]]);
+    } else if constexpr (kColor == Color::UShort) {
+        copy.colors[r] =
+            glm::u8vec3(colorByte(record + copy.colorAt[0]), colorByte(record + copy.colorAt[1]),
+                        colorByte(record + copy.colorAt[2]));
     }
     if constexpr (kIntensity == Intensity::UShort) {
         std::memcpy(&copy.intensities[r], record + copy.intensityAt, sizeof(std::uint16_t));
@@ -159,7 +172,7 @@ AttributeCopy attributeCopy(const FloatRecordLayout& layout, const FloatRecordOu
             outputs.normals, outputs.colors, outputs.intensities};
 }
 
-template <bool kNormals, bool kColors, Intensity kIntensity>
+template <bool kNormals, Color kColor, Intensity kIntensity>
 std::size_t convertScalar(const std::uint8_t* records, std::size_t count,
                           const FloatRecordLayout& layout, const FloatUnitTransform& transform,
                           const FloatRecordOutputs& outputs) {
@@ -186,7 +199,7 @@ std::size_t convertScalar(const std::uint8_t* records, std::size_t count,
                                 static_cast<double>(y) + offset.y,
                                 static_cast<double>(z) + offset.z);
         positions[r] = glm::vec3((source - origin) * inverseEdge);
-        copyOptionalAttributes<kNormals, kColors, kIntensity>(record, r, copy);
+        copyOptionalAttributes<kNormals, kColor, kIntensity>(record, r, copy);
     }
     return count;
 }
@@ -237,7 +250,7 @@ void extendSse2(const std::uint8_t* records, std::size_t count, const FloatRecor
     box.finite += finite;
 }
 
-template <bool kNormals, bool kColors, Intensity kIntensity>
+template <bool kNormals, Color kColor, Intensity kIntensity>
 std::size_t convertSse2(const std::uint8_t* records, std::size_t count,
                         const FloatRecordLayout& layout, const FloatUnitTransform& transform,
                         const FloatRecordOutputs& outputs) {
@@ -272,28 +285,28 @@ std::size_t convertSse2(const std::uint8_t* records, std::size_t count,
         float* position = &positions[r].x;
         _mm_storel_pi(reinterpret_cast<__m64*>(position), unit);
         _mm_store_ss(position + 2, _mm_movehl_ps(unit, unit));
-        copyOptionalAttributes<kNormals, kColors, kIntensity>(record, r, copy);
+        copyOptionalAttributes<kNormals, kColor, kIntensity>(record, r, copy);
     }
     return count;
 }
 
 #endif
 
-template <bool kNormals, bool kColors, Intensity kIntensity>
+template <bool kNormals, Color kColor, Intensity kIntensity>
 std::size_t convert(const std::uint8_t* records, std::size_t count, const FloatRecordLayout& layout,
                     const FloatUnitTransform& transform, const FloatRecordOutputs& outputs) {
 #if defined(__SSE2__)
     if (layout.adjacentPosition()) {
-        return convertSse2<kNormals, kColors, kIntensity>(records, count, layout, transform,
-                                                          outputs);
+        return convertSse2<kNormals, kColor, kIntensity>(records, count, layout, transform,
+                                                         outputs);
     }
 #endif
-    return convertScalar<kNormals, kColors, kIntensity>(records, count, layout, transform, outputs);
+    return convertScalar<kNormals, kColor, kIntensity>(records, count, layout, transform, outputs);
 }
 
 // Double x y z, as PDAL writes them: source = x + offset and the normalizer's own checks,
 // point by point, as the general path does (no float prefilter box to find).
-template <bool kNormals, bool kColors, Intensity kIntensity>
+template <bool kNormals, Color kColor, Intensity kIntensity>
 std::size_t convertDoubles(const std::uint8_t* records, std::size_t count,
                            const FloatRecordLayout& layout, const SourceNormalizer& normalizer,
                            const glm::dvec3& offset, const FloatRecordOutputs& outputs) {
@@ -310,36 +323,39 @@ std::size_t convertDoubles(const std::uint8_t* records, std::size_t count,
             return r;
         }
         positions[r] = normalizer.toUnit(source);
-        copyOptionalAttributes<kNormals, kColors, kIntensity>(record, r, copy);
+        copyOptionalAttributes<kNormals, kColor, kIntensity>(record, r, copy);
     }
     return count;
 }
 
-// Calls convert.template operator()<kNormals, kColors, kIntensity>() for the layout's
+// Calls convert.template operator()<kNormals, kColor, kIntensity>() for the layout's
 // optional attributes: one instantiation of a conversion loop per combination.
 template <typename Convert>
 std::size_t forLayoutAttributes(const FloatRecordLayout& layout, const Convert& convert) {
-    const auto withIntensity = [&]<bool kNormals, bool kColors>() -> std::size_t {
+    const auto withIntensity = [&]<bool kNormals, Color kColor>() -> std::size_t {
         switch (layout.intensityType) {
         case Intensity::UShort:
-            return convert.template operator()<kNormals, kColors, Intensity::UShort>();
+            return convert.template operator()<kNormals, kColor, Intensity::UShort>();
         case Intensity::Float:
-            return convert.template operator()<kNormals, kColors, Intensity::Float>();
+            return convert.template operator()<kNormals, kColor, Intensity::Float>();
         case Intensity::None:
             break;
         }
-        return convert.template operator()<kNormals, kColors, Intensity::None>();
+        return convert.template operator()<kNormals, kColor, Intensity::None>();
     };
-    if (layout.hasNormals && layout.hasColors) {
-        return withIntensity.template operator()<true, true>();
-    }
-    if (layout.hasNormals) {
-        return withIntensity.template operator()<true, false>();
-    }
-    if (layout.hasColors) {
-        return withIntensity.template operator()<false, true>();
-    }
-    return withIntensity.template operator()<false, false>();
+    const auto withColor = [&]<bool kNormals>() -> std::size_t {
+        switch (layout.colorType) {
+        case Color::UChar:
+            return withIntensity.template operator()<kNormals, Color::UChar>();
+        case Color::UShort:
+            return withIntensity.template operator()<kNormals, Color::UShort>();
+        case Color::None:
+            break;
+        }
+        return withIntensity.template operator()<kNormals, Color::None>();
+    };
+    return layout.hasNormals ? withColor.template operator()<true>()
+                             : withColor.template operator()<false>();
 }
 
 } // namespace
@@ -359,8 +375,8 @@ std::size_t convertFloatRecords(const std::uint8_t* records, std::size_t count,
                                 const FloatRecordLayout& layout,
                                 const FloatUnitTransform& transform,
                                 const FloatRecordOutputs& outputs) {
-    return forLayoutAttributes(layout, [&]<bool kNormals, bool kColors, Intensity kIntensity>() {
-        return convert<kNormals, kColors, kIntensity>(records, count, layout, transform, outputs);
+    return forLayoutAttributes(layout, [&]<bool kNormals, Color kColor, Intensity kIntensity>() {
+        return convert<kNormals, kColor, kIntensity>(records, count, layout, transform, outputs);
     });
 }
 
@@ -395,9 +411,9 @@ std::size_t convertDoubleRecords(const std::uint8_t* records, std::size_t count,
                                  const FloatRecordLayout& layout,
                                  const SourceNormalizer& normalizer, const glm::dvec3& offset,
                                  const FloatRecordOutputs& outputs) {
-    return forLayoutAttributes(layout, [&]<bool kNormals, bool kColors, Intensity kIntensity>() {
-        return convertDoubles<kNormals, kColors, kIntensity>(records, count, layout, normalizer,
-                                                             offset, outputs);
+    return forLayoutAttributes(layout, [&]<bool kNormals, Color kColor, Intensity kIntensity>() {
+        return convertDoubles<kNormals, kColor, kIntensity>(records, count, layout, normalizer,
+                                                            offset, outputs);
     });
 }
 

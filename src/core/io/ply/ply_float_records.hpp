@@ -1,8 +1,8 @@
 // Hot loops for the common binary PLY layout: native-endian float (or double) x y z, optionally
-// float normals, uchar colours and a ushort or float intensity, no lists. Both loops do only loads,
-// a few compares and the SourceNormalizer arithmetic, with an SSE2 path when x y z are adjacent;
-// everything unusual (non-finite points, points at or outside the bounds) is left to the caller's
-// exact code.
+// float normals, uchar or ushort colours and a ushort or float intensity, no lists. Both loops do
+// only loads, a few compares and the SourceNormalizer arithmetic, with an SSE2 path when x y z are
+// adjacent; everything unusual (non-finite points, points at or outside the bounds) is left to the
+// caller's exact code.
 #pragma once
 
 #include "io/source_normalizer.hpp"
@@ -25,8 +25,9 @@ struct FloatRecordLayout {
     bool doublePositions = false;          // the double loops: extendDoubleBounds, convertDouble…
     bool hasNormals = false;
     std::array<std::size_t, 3> normal{}; // float
-    bool hasColors = false;
-    std::array<std::size_t, 3> color{}; // uchar
+    // uchar (copied), or ushort (scaled to 8 bits as plyColorChannel: PDAL writes LAS colours so)
+    enum class Color { None, UChar, UShort } colorType = Color::None;
+    std::array<std::size_t, 3> color{};
     // ushort (copied), or float (rounded and clamped as plyIntensity: CloudCompare's
     // scalar_Intensity)
     enum class Intensity { None, UShort, Float } intensityType = Intensity::None;

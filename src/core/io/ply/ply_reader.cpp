@@ -766,13 +766,14 @@ bool PlyReader::intensityOnFastPath() const {
     return type == PlyScalarType::UInt16 || type == PlyScalarType::Float32;
 }
 
-// The layout of ../shared/data, most scanners, CloudCompare, PDAL (double positions) and our
-// own converter: float or double positions, optionally float normals, uchar colours and a
-// ushort or float intensity.
+// The layout of ../shared/data, most scanners, CloudCompare, PDAL (double positions, ushort
+// colours) and our own converter: float or double positions, optionally float normals, uchar
+// or ushort colours and a ushort or float intensity.
 bool PlyReader::fastLayout() const {
     return fastPositions() &&
            (!m_fields.hasNormals() || hasType(m_fields.normal, PlyScalarType::Float32)) &&
-           (!m_fields.hasColors() || hasType(m_fields.color, PlyScalarType::UInt8)) &&
+           (!m_fields.hasColors() || hasType(m_fields.color, PlyScalarType::UInt8) ||
+            hasType(m_fields.color, PlyScalarType::UInt16)) &&
            intensityOnFastPath();
 }
 
@@ -790,7 +791,11 @@ FloatRecordLayout PlyReader::floatLayout() const {
         }
     }
     layout.hasNormals = m_fields.hasNormals();
-    layout.hasColors = m_fields.hasColors();
+    if (m_fields.hasColors()) {
+        layout.colorType = hasType(m_fields.color, PlyScalarType::UInt8)
+                               ? FloatRecordLayout::Color::UChar
+                               : FloatRecordLayout::Color::UShort;
+    }
     if (m_fields.hasIntensity()) {
         layout.intensityType = vertex().properties[m_fields.intensity].type == PlyScalarType::UInt16
                                    ? FloatRecordLayout::Intensity::UShort
@@ -926,7 +931,9 @@ bool PlyReader::readFastLayout(const SourceNormalizer& normalizer, BatchSink& si
                 FloatRecordOutputs outputs;
                 outputs.positions = batch.positions.data() + slot;
                 outputs.normals = layout.hasNormals ? batch.normals.data() + slot : nullptr;
-                outputs.colors = layout.hasColors ? batch.colors.data() + slot : nullptr;
+                outputs.colors = layout.colorType != FloatRecordLayout::Color::None
+                                     ? batch.colors.data() + slot
+                                     : nullptr;
                 outputs.intensities =
                     m_fields.hasIntensity() ? batch.intensities.data() + slot : nullptr;
                 const std::uint8_t* first = records + done * layout.recordBytes;

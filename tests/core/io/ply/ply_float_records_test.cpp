@@ -55,7 +55,7 @@ std::vector<std::uint8_t> makeRecords(const std::vector<glm::vec3>& points, bool
     layout.recordBytes = adjacent ? 15 : 18;
     layout.position =
         adjacent ? std::array<std::size_t, 3>{0, 4, 8} : std::array<std::size_t, 3>{14, 1, 7};
-    layout.hasColors = true;
+    layout.colorType = FloatRecordLayout::Color::UChar;
     layout.color =
         adjacent ? std::array<std::size_t, 3>{12, 13, 14} : std::array<std::size_t, 3>{0, 5, 6};
     std::vector<std::uint8_t> bytes(points.size() * layout.recordBytes + kFloatRecordPadding, 0xff);

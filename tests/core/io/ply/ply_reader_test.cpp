@@ -732,6 +732,47 @@ TEST(PlyReaderLayout, DoublePositionsOnTheFastPathAgreeWithTheGeneralOne) {
                unitTolerance(fast));
 }
 
+// PDAL's PLY from a LAS file: double x y z, ushort intensity, LAS fields the reader ignores and
+// ushort red green blue. The fast loops scale the colours to 8 bits exactly as the general
+// code does (every 16-bit value, the ends included), little- and big-endian.
+TEST(PlyReaderLayout, UShortColoursOnTheFastPathAgreeWithTheGeneralOne) {
+    const std::string properties =
+        "property double x\nproperty double y\nproperty double z\nproperty ushort intensity\n"
+        "property uchar classification\nproperty ushort red\nproperty ushort green\n"
+        "property ushort blue\n";
+    constexpr std::size_t kPoints = 70'000; // more than every 16-bit value, two pre-pass blocks
+    test::TempDir dir;
+    PlyBytes little(binaryHeader(kPoints, properties));
+    PlyBytes big(binaryHeader(kPoints, properties, "binary_big_endian"), true);
+    PlyBytes general(binaryHeader(kPoints, properties + kEmptyList));
+    for (std::size_t i = 0; i < kPoints; ++i) {
+        const double x = 1000.0 + 0.25 * static_cast<double>(i % 1000);
+        const double y = 2000.0 + 0.125 * static_cast<double>(i / 1000);
+        const double z = i % 9001 == 17 ? std::numeric_limits<double>::quiet_NaN() : 3.5;
+        const auto red = static_cast<std::uint16_t>(i % 65536);
+        const auto green = static_cast<std::uint16_t>(65535 - i % 65536);
+        const auto blue = static_cast<std::uint16_t>((i * 7919) % 65536);
+        for (PlyBytes* bytes : {&little, &big, &general}) {
+            bytes->put(x).put(y).put(z).put(static_cast<std::uint16_t>(i)).put(std::uint8_t(2));
+            bytes->put(red).put(green).put(blue);
+        }
+        general.put(std::uint8_t(0));
+    }
+    little.write(dir.file("le.ply"));
+    big.write(dir.file("be.ply"));
+    general.write(dir.file("general.ply"));
+    const ReadResult fast = readAll(dir.file("le.ply"));
+    ASSERT_TRUE(fast.info.attributes.has(Attribute::Color));
+    EXPECT_EQ(fast.summary.skippedNonFinite, 8u); // i = 17, 9018, ... below 70,000
+    expectTheSameRead(fast, readAll(dir.file("general.ply")));
+    expectTheSameRead(fast, readAll(dir.file("be.ply")));
+    EXPECT_EQ(fast.points.colors[0], glm::u8vec3(0, 255, 0));
+    // Points 128 and 129 (point 17 was skipped): 128 / 257 = 0.498 and 129 / 257 = 0.502 for
+    // red, 65407 / 257 = 254.502 and 65406 / 257 = 254.498 for green.
+    EXPECT_EQ(fast.points.colors[127], glm::u8vec3(0, 255, 119));
+    EXPECT_EQ(fast.points.colors[128], glm::u8vec3(1, 254, 150));
+}
+
 TEST(PlyReaderLayout, CrlfHeaderAndBody) {
     test::TempDir dir;
     const std::string binaryPath = dir.file("crlf.ply");
