@@ -3,8 +3,8 @@
 // (batches, cancellation, known bounds, non-finite points) and one test per malformed input.
 #include "io/input_error.hpp"
 #include "io/ply/ply_reader.hpp"
-#include "io/point_reader.hpp"
 #include "io/ply/ply_writer.hpp"
+#include "io/point_reader.hpp"
 #include "test_files.hpp"
 
 #include <algorithm>
@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <gtest/gtest.h>
 #include <limits>
 #include <string>
@@ -601,6 +602,40 @@ void expectTheSameRead(const ReadResult& fast, const ReadResult& general) {
     EXPECT_EQ(fast.points.intensities, general.points.intensities);
 }
 
+// The same vertices in three files: little- and big-endian fixed records (the fast loops, the
+// big-endian ones after a byte swap) and little-endian records with an empty list
+// (variable-size: the general code, value by value). `header(format, moreProperties)`.
+class ThreeEncodings {
+public:
+    explicit ThreeEncodings(
+        const std::function<std::string(const char*, const std::string&)>& header)
+        : m_little(header("binary_little_endian", "")),
+          m_big(header("binary_big_endian", ""), true),
+          m_general(header("binary_little_endian", kEmptyList)) {}
+
+    // put(bytes) writes one vertex's values into each.
+    template <typename Put> void vertex(const Put& put) {
+        for (PlyBytes* bytes : {&m_little, &m_big, &m_general}) {
+            put(*bytes);
+        }
+        m_general.put(std::uint8_t(0));
+    }
+
+    // The little-endian read, after checking that the other two read the same.
+    ReadResult readAll(const test::TempDir& dir) const {
+        m_little.write(dir.file("le.ply"));
+        m_big.write(dir.file("be.ply"));
+        m_general.write(dir.file("general.ply"));
+        ReadResult fast = omicron::readAll(dir.file("le.ply"));
+        expectTheSameRead(fast, omicron::readAll(dir.file("general.ply")));
+        expectTheSameRead(fast, omicron::readAll(dir.file("be.ply")));
+        return fast;
+    }
+
+private:
+    PlyBytes m_little, m_big, m_general;
+};
+
 // A ushort or float intensity (CloudCompare's "scalar_Intensity"), beside float positions and
 // uchar colours, is read by the fast loops (and the bounds by the parallel pre-pass, over
 // several 1 MiB blocks) exactly as the general code reads it from the same values (records
@@ -635,9 +670,9 @@ TEST(PlyReaderLayout, IntensityOnTheFastPathAgreesWithTheGeneralOne) {
     for (const Layout& layout : layouts) {
         SCOPED_TRACE(layout.name);
         test::TempDir dir;
-        PlyBytes little(binaryHeader(kPoints, layout.properties, "binary_little_endian"));
-        PlyBytes big(binaryHeader(kPoints, layout.properties, "binary_big_endian"), true);
-        PlyBytes general(binaryHeader(kPoints, layout.properties + kEmptyList));
+        ThreeEncodings files([&](const char* format, const std::string& more) {
+            return binaryHeader(kPoints, layout.properties + more, format);
+        });
         for (std::size_t i = 0; i < kPoints; ++i) {
             // A NaN point now and then: skipped and counted by both paths.
             const float x = i % 9973 == 5 ? std::numeric_limits<float>::quiet_NaN()
@@ -649,29 +684,23 @@ TEST(PlyReaderLayout, IntensityOnTheFastPathAgreesWithTheGeneralOne) {
             const float floatIntensity = i % 101 == 3 ? std::numeric_limits<float>::quiet_NaN()
                                                       : 0.37f * static_cast<float>(i) - 1000.0f;
             const auto rgb = glm::u8vec3(i % 256, (i / 256) % 256, (3 * i) % 256);
-            for (PlyBytes* bytes : {&little, &big, &general}) {
+            files.vertex([&](PlyBytes& bytes) {
                 if (layout.apart) {
-                    bytes->put(intensity).put(z).put(rgb.r).put(x).put(rgb.g).put(rgb.b).put(y);
+                    bytes.put(intensity).put(z).put(rgb.r).put(x).put(rgb.g).put(rgb.b).put(y);
                 } else {
-                    bytes->put(x).put(y).put(z).put(rgb.r).put(rgb.g).put(rgb.b);
+                    bytes.put(x).put(y).put(z).put(rgb.r).put(rgb.g).put(rgb.b);
                     if (layout.floatIntensity) {
-                        bytes->put(floatIntensity);
+                        bytes.put(floatIntensity);
                     } else {
-                        bytes->put(intensity);
+                        bytes.put(intensity);
                     }
                 }
-                bytes->put(float(i));
-            }
-            general.put(std::uint8_t(0));
+                bytes.put(float(i));
+            });
         }
-        little.write(dir.file("le.ply"));
-        big.write(dir.file("be.ply"));
-        general.write(dir.file("general.ply"));
-        const ReadResult fast = readAll(dir.file("le.ply"));
+        const ReadResult fast = files.readAll(dir);
         ASSERT_TRUE(fast.info.attributes.has(Attribute::Intensity));
         EXPECT_EQ(fast.summary.skippedNonFinite, 26u); // i = 5, 9978, ... below 250,000
-        expectTheSameRead(fast, readAll(dir.file("general.ply")));
-        expectTheSameRead(fast, readAll(dir.file("be.ply")));
         ASSERT_EQ(fast.points.intensities.size(), kPoints - 26);
         if (layout.floatIntensity) {
             EXPECT_EQ(fast.points.intensities[3], 0);         // NaN
@@ -696,36 +725,28 @@ TEST(PlyReaderLayout, DoublePositionsOnTheFastPathAgreeWithTheGeneralOne) {
         "property double x\nproperty double y\nproperty double z\nproperty float nx\n"
         "property float ny\nproperty float nz\nproperty uchar red\nproperty uchar green\n"
         "property uchar blue\nproperty ushort intensity\n";
-    const auto header = [&](const char* format, const std::string& more = "") {
+    const auto header = [&](const char* format, const std::string& more) {
         return "ply\nformat " + std::string(format) +
                " 1.0\ncomment offset 635000 848000 0\nelement vertex 150000\n" + properties + more +
                "end_header\n";
     };
     constexpr std::size_t kPoints = 150'000; // 45-byte records: 6.75 MB, seven pre-pass blocks
     test::TempDir dir;
-    PlyBytes little(header("binary_little_endian"));
-    PlyBytes big(header("binary_big_endian"), true);
-    PlyBytes general(header("binary_little_endian", kEmptyList));
+    ThreeEncodings files(header);
     for (std::size_t i = 0; i < kPoints; ++i) {
         const double x = i % 7919 == 11 ? std::numeric_limits<double>::infinity()
                                         : 577.123456789 + 0.0731 * static_cast<double>(i % 40000);
         const double y = 882.5 + 1e-7 * static_cast<double>(i * i % 1000003);
         const double z = 406.25 + std::sin(1e-4 * static_cast<double>(i));
         const glm::vec3 normal(0.0f, 0.6f, i % 2 == 0 ? 0.8f : -0.8f);
-        for (PlyBytes* bytes : {&little, &big, &general}) {
-            bytes->put(x).put(y).put(z).put(normal.x).put(normal.y).put(normal.z);
-            bytes->put(std::uint8_t(i % 251)).put(std::uint8_t(i % 13)).put(std::uint8_t(7));
-            bytes->put(static_cast<std::uint16_t>(i % 60000));
-        }
-        general.put(std::uint8_t(0));
+        files.vertex([&](PlyBytes& bytes) {
+            bytes.put(x).put(y).put(z).put(normal.x).put(normal.y).put(normal.z);
+            bytes.put(std::uint8_t(i % 251)).put(std::uint8_t(i % 13)).put(std::uint8_t(7));
+            bytes.put(static_cast<std::uint16_t>(i % 60000));
+        });
     }
-    little.write(dir.file("le.ply"));
-    big.write(dir.file("be.ply"));
-    general.write(dir.file("general.ply"));
-    const ReadResult fast = readAll(dir.file("le.ply"));
+    const ReadResult fast = files.readAll(dir);
     EXPECT_EQ(fast.summary.skippedNonFinite, 19u); // i = 11, 7930, ... below 150,000
-    expectTheSameRead(fast, readAll(dir.file("general.ply")));
-    expectTheSameRead(fast, readAll(dir.file("be.ply")));
     ASSERT_EQ(fast.points.size(), kPoints - 19);
     EXPECT_DOUBLE_EQ(fast.info.sourceBounds.min.x, 635577.123456789);
     expectNear(sourceOf(fast, 1), {635577.123456789 + 0.0731, 848882.5 + 1e-7, 406.25 + 1e-4},
@@ -742,9 +763,9 @@ TEST(PlyReaderLayout, UShortColoursOnTheFastPathAgreeWithTheGeneralOne) {
         "property ushort blue\n";
     constexpr std::size_t kPoints = 70'000; // more than every 16-bit value, two pre-pass blocks
     test::TempDir dir;
-    PlyBytes little(binaryHeader(kPoints, properties));
-    PlyBytes big(binaryHeader(kPoints, properties, "binary_big_endian"), true);
-    PlyBytes general(binaryHeader(kPoints, properties + kEmptyList));
+    ThreeEncodings files([&](const char* format, const std::string& more) {
+        return binaryHeader(kPoints, properties + more, format);
+    });
     for (std::size_t i = 0; i < kPoints; ++i) {
         const double x = 1000.0 + 0.25 * static_cast<double>(i % 1000);
         const double y = 2000.0 + 0.125 * static_cast<double>(i / 1000);
@@ -752,20 +773,14 @@ TEST(PlyReaderLayout, UShortColoursOnTheFastPathAgreeWithTheGeneralOne) {
         const auto red = static_cast<std::uint16_t>(i % 65536);
         const auto green = static_cast<std::uint16_t>(65535 - i % 65536);
         const auto blue = static_cast<std::uint16_t>((i * 7919) % 65536);
-        for (PlyBytes* bytes : {&little, &big, &general}) {
-            bytes->put(x).put(y).put(z).put(static_cast<std::uint16_t>(i)).put(std::uint8_t(2));
-            bytes->put(red).put(green).put(blue);
-        }
-        general.put(std::uint8_t(0));
+        files.vertex([&](PlyBytes& bytes) {
+            bytes.put(x).put(y).put(z).put(static_cast<std::uint16_t>(i)).put(std::uint8_t(2));
+            bytes.put(red).put(green).put(blue);
+        });
     }
-    little.write(dir.file("le.ply"));
-    big.write(dir.file("be.ply"));
-    general.write(dir.file("general.ply"));
-    const ReadResult fast = readAll(dir.file("le.ply"));
+    const ReadResult fast = files.readAll(dir);
     ASSERT_TRUE(fast.info.attributes.has(Attribute::Color));
     EXPECT_EQ(fast.summary.skippedNonFinite, 8u); // i = 17, 9018, ... below 70,000
-    expectTheSameRead(fast, readAll(dir.file("general.ply")));
-    expectTheSameRead(fast, readAll(dir.file("be.ply")));
     EXPECT_EQ(fast.points.colors[0], glm::u8vec3(0, 255, 0));
     // Points 128 and 129 (point 17 was skipped): 128 / 257 = 0.498 and 129 / 257 = 0.502 for
     // red, 65407 / 257 = 254.502 and 65406 / 257 = 254.498 for green.
