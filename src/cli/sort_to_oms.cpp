@@ -59,7 +59,8 @@ SortToOmsResult sortToOms(const std::string& inPath, const std::string& outPath,
     };
     if (sorter.spills()) {
         sorter.emitSortedBatches([&](const PointBatch& sorted) {
-            openOnce(*sorter.cloud()); // the cloud only gives the cube; it stays empty
+            // The cloud only gives the cube and the uniform columns; it stays empty.
+            openOnce(*sorter.cloud());
             writer.append(sorted);
             result.written += sorted.size();
             progress.update("merging runs into the sorted stream", result.written,

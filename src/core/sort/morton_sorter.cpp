@@ -227,13 +227,13 @@ void IncrementalMortonSorter::checkUniformColumns(const PointBatch& batch, std::
         const bool same =
             std::memcmp(records.data(), m_uniformLasRecord.data(), bytes) == 0 &&
             std::memcmp(records.data() + bytes, records.data(), records.size() - bytes) == 0;
-        if (!same && m_spiller) {
+        if (!same) {
             m_uniform[kLas].store(false, std::memory_order_relaxed);
-        } else if (!same) {
-            m_uniform[kLas].store(false, std::memory_order_relaxed);
-            m_input.las.resize(firstIndex * bytes);
-            for (std::size_t i = 0; i < firstIndex; ++i) {
-                std::memcpy(m_input.las.data() + i * bytes, m_uniformLasRecord.data(), bytes);
+            if (!m_spiller) {
+                m_input.las.resize(firstIndex * bytes);
+                for (std::size_t i = 0; i < firstIndex; ++i) {
+                    std::memcpy(m_input.las.data() + i * bytes, m_uniformLasRecord.data(), bytes);
+                }
             }
         }
     }
