@@ -2,6 +2,7 @@
 
 #include "formats/omh_pager.hpp"
 #include "formats/omh_record_decoder.hpp"
+#include "hex_text.hpp"
 #include "io/input_error.hpp"
 #include "io/raw_bytes.hpp"
 
@@ -10,7 +11,6 @@
 #include <bit>
 #include <cctype>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <optional>
@@ -22,12 +22,6 @@ namespace {
 
 // Point records are read and decoded in blocks of about this size.
 constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
-
-std::string hex(std::uint64_t value) {
-    char text[19];
-    std::snprintf(text, sizeof(text), "0x%016llx", static_cast<unsigned long long>(value));
-    return text;
-}
 
 bool isFinite(const glm::dvec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -138,9 +132,9 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     const std::uint64_t headerChecksum = omh::smallChecksum(header.data(), h::kChecksum);
     if (storedChecksum != headerChecksum) {
         throw error(InputErrorKind::MalformedHeader, h::kChecksum,
-                    "header checksum mismatch: the header stores XXH64 " + hex(storedChecksum) +
+                    "header checksum mismatch: the header stores XXH64 " + hexText(storedChecksum) +
                         " for bytes 0-" + std::to_string(h::kChecksum - 1) + ", they hash to " +
-                        hex(headerChecksum) + ": the header is damaged");
+                        hexText(headerChecksum) + ": the header is damaged");
     }
 
     // The checksum matched, so what follows can only fail for a file that a writer other than
@@ -282,10 +276,11 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     const auto storedTableChecksum = loadRaw<std::uint64_t>(table.data() + entryBytes);
     const std::uint64_t tableChecksum = omh::smallChecksum(table.data(), entryBytes);
     if (storedTableChecksum != tableChecksum) {
-        throw error(InputErrorKind::MalformedHeader, omh::kHeaderBytes + entryBytes,
-                    "level table checksum mismatch: it stores XXH64 " + hex(storedTableChecksum) +
-                        " for " + range(omh::kHeaderBytes, omh::kHeaderBytes + entryBytes) +
-                        ", they hash to " + hex(tableChecksum) + ": the level table is damaged");
+        throw error(
+            InputErrorKind::MalformedHeader, omh::kHeaderBytes + entryBytes,
+            "level table checksum mismatch: it stores XXH64 " + hexText(storedTableChecksum) +
+                " for " + range(omh::kHeaderBytes, omh::kHeaderBytes + entryBytes) +
+                ", they hash to " + hexText(tableChecksum) + ": the level table is damaged");
     }
     info.levels.resize(levelCount);
     std::uint64_t nodes = 0, points = 0;
@@ -438,7 +433,8 @@ std::vector<OctreeNode> OmhReader::readNodes(int level, std::vector<std::uint8_t
         throw InputError(InputErrorKind::MalformedValue, m_header.path,
                          InputLocation::byte(entry.nodeTableOffset),
                          "checksum mismatch in " + section + ": the level table stores XXH3-64 " +
-                             hex(entry.nodeChecksum) + ", the records hash to " + hex(checksum));
+                             hexText(entry.nodeChecksum) + ", the records hash to " +
+                             hexText(checksum));
     }
     // Level 0 is the root; every deeper level holds exactly the children its parents' masks
     // announce, in Morton order (what the builder's arenas hold).
@@ -468,9 +464,9 @@ std::vector<OctreeNode> OmhReader::readNodes(int level, std::vector<std::uint8_t
         OctreeNode& node = nodes[i];
         node.code = loadRaw<std::uint64_t>(record + omh::node::kCode);
         if (node.code != expectedCodes[i]) {
-            throw bad(omh::node::kCode, "expected code " + hex(expectedCodes[i]) +
+            throw bad(omh::node::kCode, "expected code " + hexText(expectedCodes[i]) +
                                             " (announced by its parent's child mask), found " +
-                                            hex(node.code));
+                                            hexText(node.code));
         }
         const auto first = loadRaw<std::uint64_t>(record + omh::node::kFirstPoint);
         if (first != firstPoint + points) {
@@ -569,10 +565,10 @@ void OmhReader::readPoints(int level, const std::vector<OctreeNode>& nodes,
     }
     const std::uint64_t digest = checksum.digest();
     if (digest != entry.payloadChecksum) {
-        throw InputError(InputErrorKind::MalformedValue, m_header.path,
-                         InputLocation::byte(entry.payloadOffset),
-                         "checksum mismatch in " + section + ": the level table stores XXH3-64 " +
-                             hex(entry.payloadChecksum) + ", the records hash to " + hex(digest));
+        throw InputError(
+            InputErrorKind::MalformedValue, m_header.path, InputLocation::byte(entry.payloadOffset),
+            "checksum mismatch in " + section + ": the level table stores XXH3-64 " +
+                hexText(entry.payloadChecksum) + ", the records hash to " + hexText(digest));
     }
     if (firstProblem) {
         throw *firstProblem;
@@ -644,7 +640,7 @@ void OmhReader::verify() {
                              "checksum mismatch in " + section +
                                  ": the level table stores "
                                  "XXH3-64 " +
-                                 hex(expected) + ", the bytes hash to " + hex(digest));
+                                 hexText(expected) + ", the bytes hash to " + hexText(digest));
         }
     };
     // Header, level table and footer were verified at open.

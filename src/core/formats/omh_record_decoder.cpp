@@ -1,10 +1,10 @@
 #include "formats/omh_record_decoder.hpp"
 
 #include "formats/omh_reader.hpp"
+#include "hex_text.hpp"
 #include "io/raw_bytes.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 
 namespace omicron {
@@ -57,12 +57,10 @@ InputError OmhRecordDecoder::misplaced(int level, std::uint64_t recordInLevel,
                                        morton::Code nodeCode) const {
     const std::uint64_t byte = m_header.levels[static_cast<std::size_t>(level)].payloadOffset +
                                recordInLevel * m_layout.bytes;
-    char code[19];
-    std::snprintf(code, sizeof(code), "0x%016llx", static_cast<unsigned long long>(nodeCode));
     return InputError(InputErrorKind::MalformedValue, m_header.path, InputLocation::byte(byte),
                       "in " + omhSectionAt(m_header, byte) + ", record " +
                           std::to_string(recordInLevel) +
-                          ": the position lies outside the cell of its node " + code);
+                          ": the position lies outside the cell of its node " + hexText(nodeCode));
 }
 
 } // namespace omicron

@@ -1,5 +1,7 @@
 #include "formats/oms_format.hpp"
 
+#include "points/sorted_cloud.hpp"
+
 #include <stdexcept>
 
 // Header-only xxHash (Debian's libxxhash-dev): inlined here, no library to link.

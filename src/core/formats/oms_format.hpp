@@ -20,7 +20,6 @@
 
 #include "points/point_batch.hpp"
 #include "points/point_records.hpp"
-#include "points/sorted_cloud.hpp"
 
 #include <array>
 #include <bit>
@@ -28,6 +27,10 @@
 #include <cstdint>
 #include <memory>
 #include <vector>
+
+namespace omicron {
+class SortedCloud;
+}
 
 namespace omicron::oms {
 

@@ -1,6 +1,7 @@
 #include "formats/oms_reader.hpp"
 
 #include "formats/oms_record_decoder.hpp"
+#include "hex_text.hpp"
 #include "io/input_error.hpp"
 #include "io/raw_bytes.hpp"
 #include "sort/budgeted_cloud.hpp"
@@ -23,13 +24,6 @@ namespace {
 
 // Records are read and decoded in blocks of at most this size (and at most one range).
 constexpr std::size_t kBlockBytes = std::size_t{4} << 20;
-
-// `digits` hex digits: 16 for checksums and codes, fewer for small fields.
-std::string hex(std::uint64_t value, int digits = 16) {
-    char text[19];
-    std::snprintf(text, sizeof(text), "0x%0*llx", digits, static_cast<unsigned long long>(value));
-    return text;
-}
 
 // Printable ASCII as is, anything else as \xNN: for showing a wrong magic.
 std::string quoteBytes(const std::uint8_t* bytes, std::size_t count) {
@@ -93,7 +87,7 @@ oms::UniformColumns parseUniformColumns(const std::array<std::uint8_t, oms::kHea
         throw malformed(h::kUniformColumns,
                         "expected uniform column bits within 0x03 (intensity 1, LAS column 2), "
                         "found " +
-                            hex(uniform.bits, 2));
+                            hexText(uniform.bits, 2));
     }
     if (uniform.intensityUniform() && !attributes.has(Attribute::Intensity)) {
         throw malformed(h::kUniformColumns,
@@ -188,8 +182,8 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage, std::uint64_
     }
     if (endianness != oms::kEndiannessMarker) {
         throw error(InputErrorKind::MalformedHeader, h::kEndianness,
-                    "expected the endianness marker " + hex(oms::kEndiannessMarker, 8) +
-                        ", found " + hex(endianness, 8));
+                    "expected the endianness marker " + hexText(oms::kEndiannessMarker, 8) +
+                        ", found " + hexText(endianness, 8));
     }
     const auto version = loadRaw<std::uint32_t>(header.data() + h::kVersion);
     if (version < oms::kOldestVersion || version > oms::kVersion) {
@@ -203,8 +197,8 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage, std::uint64_
     if (storedHeaderChecksum != headerChecksum) {
         throw error(InputErrorKind::MalformedHeader, h::kChecksum,
                     "header checksum mismatch: expected the stored XXH64 " +
-                        hex(storedHeaderChecksum) + " of bytes 0-" +
-                        std::to_string(h::kChecksum - 1) + ", computed " + hex(headerChecksum) +
+                        hexText(storedHeaderChecksum) + " of bytes 0-" +
+                        std::to_string(h::kChecksum - 1) + ", computed " + hexText(headerChecksum) +
                         ": the header is damaged");
     }
 
@@ -217,16 +211,16 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage, std::uint64_
     const auto attributeBits = loadRaw<std::uint8_t>(header.data() + h::kAttributes);
     if ((attributeBits & ~oms::kKnownAttributeBits) != 0) {
         throw error(InputErrorKind::UnsupportedFeature, h::kAttributes,
-                    "expected attribute bits within " + hex(oms::kKnownAttributeBits, 2) +
+                    "expected attribute bits within " + hexText(oms::kKnownAttributeBits, 2) +
                         " (normal 1, colour 2, intensity 4, LAS 8, GPS time 16, NIR 32), "
                         "found " +
-                        hex(attributeBits, 2));
+                        hexText(attributeBits, 2));
     }
     const auto extraBytes = loadRaw<std::uint16_t>(header.data() + h::kExtraBytes);
     const AttributeSet attributes = AttributeSet::fromBits(attributeBits, extraBytes);
     if (!attributes.valid()) {
         throw error(InputErrorKind::MalformedHeader, h::kAttributes,
-                    "attribute bits " + hex(attributeBits, 2) + " with " +
+                    "attribute bits " + hexText(attributeBits, 2) + " with " +
                         std::to_string(extraBytes) +
                         " extra bytes: GPS time, NIR and extra bytes need the LAS bit (8)");
     }
@@ -236,8 +230,8 @@ OmsReader::OmsReader(const std::string& path, PointStorage storage, std::uint64_
     if (recordBytes != m_layout.bytes) {
         throw error(InputErrorKind::MalformedHeader, h::kRecordBytes,
                     "expected a record size of " + std::to_string(m_layout.bytes) +
-                        " bytes for attribute bits " + hex(attributeBits, 2) +
-                        (uniform.bits != 0 ? " and uniform column bits " + hex(uniform.bits, 2)
+                        " bytes for attribute bits " + hexText(attributeBits, 2) +
+                        (uniform.bits != 0 ? " and uniform column bits " + hexText(uniform.bits, 2)
                                            : std::string()) +
                         ", found " + std::to_string(recordBytes));
     }
@@ -378,10 +372,10 @@ ReadSummary OmsReader::read(const SortedRangeConsumer& consumer, const ReadOptio
         throw InputError(InputErrorKind::MalformedValue, m_info.path,
                          InputLocation::byte(footerStart + oms::footer::kChecksum),
                          "payload checksum mismatch: the footer stores XXH3-64 " +
-                             hex(m_expectedPayloadChecksum) + " for the record bytes " +
+                             hexText(m_expectedPayloadChecksum) + " for the record bytes " +
                              std::to_string(oms::kHeaderBytes) + "-" +
                              std::to_string(footerStart - 1) + ", they hash to " +
-                             hex(payloadChecksum) + ": the records are damaged");
+                             hexText(payloadChecksum) + ": the records are damaged");
     }
     cloud.markComplete();
     return summary;

@@ -1,5 +1,6 @@
 #include "formats/oms_record_decoder.hpp"
 
+#include "hex_text.hpp"
 #include "io/input_error.hpp"
 #include "io/raw_bytes.hpp"
 #include "points/morton_batch.hpp"
@@ -7,23 +8,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <span>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 namespace omicron {
-
-namespace {
-
-std::string hex(std::uint64_t value) {
-    char text[19];
-    std::snprintf(text, sizeof(text), "0x%016llx", static_cast<unsigned long long>(value));
-    return text;
-}
-
-} // namespace
 
 OmsRecordDecoder::OmsRecordDecoder(const oms::RecordLayout& layout, AttributeSet attributes,
                                    std::string path)
@@ -117,7 +107,8 @@ morton::Code OmsRecordDecoder::throwFirstBadRecord(std::size_t first,
         return InputError(InputErrorKind::MalformedValue, m_path, InputLocation::byte(at),
                           "record " + std::to_string(record) + " at byte " + std::to_string(at) +
                               " is out of Morton order: the file is not sorted (its code " +
-                              hex(code) + " is below the previous record's " + hex(before) + ")");
+                              hexText(code) + " is below the previous record's " + hexText(before) +
+                              ")");
     };
     for (std::size_t g = 0; g < m_checks.size(); ++g) {
         const GrainCheck& check = m_checks[g];

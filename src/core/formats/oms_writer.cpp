@@ -198,13 +198,11 @@ void OmsWriter::encodeRecord(std::uint64_t index, const glm::vec3& position,
     if (m_attributes.has(Attribute::Color)) {
         storeRaw(record + m_layout.colorOffset, *color);
     }
-    if (m_attributes.has(Attribute::Intensity)) {
-        if (!m_uniform.intensityUniform()) {
-            storeRaw(record + m_layout.intensityOffset, *intensity);
-        } else if (*intensity != m_uniform.intensity) {
-            fail("point " + std::to_string(index) + " has intensity " + std::to_string(*intensity) +
-                 ", not the uniform " + std::to_string(m_uniform.intensity) + " given at open()");
-        }
+    if (m_layout.intensity) {
+        storeRaw(record + m_layout.intensityOffset, *intensity);
+    } else if (m_uniform.intensityUniform() && *intensity != m_uniform.intensity) {
+        fail("point " + std::to_string(index) + " has intensity " + std::to_string(*intensity) +
+             ", not the uniform " + std::to_string(m_uniform.intensity) + " given at open()");
     }
     if (m_layout.lasBytes != 0) {
         std::memcpy(record + m_layout.lasOffset, las, m_layout.lasBytes);

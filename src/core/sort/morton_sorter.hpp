@@ -173,9 +173,9 @@ private:
     std::array<ArrivalColumn, kColumns> m_arrivalColumns;
     // Per column, true while every point added so far has the first point's value (only ever
     // for the intensities and the LAS column): such a column's arrival array stays empty and
-    // untouched (a spilling sort's runs keep it), and the sorted cloud stores the value once.
-    // Many LAS files hold zeros in most fields (converted or photogrammetric clouds: no GPS time,
-    // intensity or returns). Atomic: populateAhead() reads them on another thread.
+    // untouched (a spilling sort's runs leave it out), and the sorted cloud stores the value
+    // once. Many LAS files hold zeros in most fields (converted or photogrammetric clouds: no GPS
+    // time, intensity or returns). Atomic: populateAhead() reads them on another thread.
     std::array<std::atomic<bool>, kColumns> m_uniform{};
     std::uint16_t m_uniformIntensity = 0;
     std::vector<std::uint8_t> m_uniformLasRecord;
