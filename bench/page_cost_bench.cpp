@@ -10,6 +10,10 @@
 //   file_again   pwrite of the same bytes over that file's existing pages (the baseline)
 //
 // usage: page_cost_bench [--mib N] [--dir DIR]   (default 1024 MiB in /dev/shm)
+//        page_cost_bench --mib N --populate-only   (maps N MiB, populates them in one call and
+//                                                   exits: bench/kernel_floor.sh times it as a
+//                                                   whole process, the floor of a peak resident
+//                                                   set of N MiB)
 // Lines: bench=page_cost case=... mib= ms= ns_per_page= gb_per_s= minor_faults=
 //        bench=page_cost summary fresh_anonymous_s_per_gb= fresh_file_s_per_gb= ...
 #include "bench_timing.hpp"
@@ -97,14 +101,18 @@ void writeAll(int fd, const std::uint8_t* data, std::size_t bytes, const std::st
 int main(int argc, char** argv) {
     std::size_t mib = 1024;
     std::string dir = "/dev/shm";
+    bool populateOnly = false;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--mib" && i + 1 < argc) {
             mib = std::strtoull(argv[++i], nullptr, 10);
         } else if (arg == "--dir" && i + 1 < argc) {
             dir = argv[++i];
+        } else if (arg == "--populate-only") {
+            populateOnly = true;
         } else {
-            std::fprintf(stderr, "usage: page_cost_bench [--mib N] [--dir DIR]\n");
+            std::fprintf(
+                stderr, "usage: page_cost_bench [--mib N] [--dir DIR] | --mib N --populate-only\n");
             return 2;
         }
     }
@@ -113,6 +121,19 @@ int main(int argc, char** argv) {
         return 2;
     }
     const std::size_t bytes = mib << 20;
+    if (populateOnly) {
+        const long faultsBefore = minorFaults();
+        const auto start = Clock::now();
+        void* memory = mapAnonymous(bytes);
+        if (madvise(memory, bytes, MADV_POPULATE_WRITE) != 0) {
+            std::fprintf(stderr, "page_cost_bench: MADV_POPULATE_WRITE: %s\n",
+                         std::strerror(errno));
+            return 1;
+        }
+        print("populate_only", bytes, {secondsSince(start), minorFaults() - faultsBefore});
+        munmap(memory, bytes);
+        return 0;
+    }
 
     // The source: faulted in and filled once, outside every timing.
     auto* source = static_cast<std::uint8_t*>(mapAnonymous(bytes));
