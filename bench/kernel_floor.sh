@@ -54,13 +54,13 @@ for run in $(seq 1 "$runs"); do
   done
 done
 
-ours_user=$(echo "${users[ours]}" | median)
-ours_sys=$(echo "${syss[ours]}" | median)
-read_sys=$(echo "${syss[read]}" | median)
-write_sys=$(echo "${syss[write]}" | median)
-omh_read_sys=$(echo "${syss[omh_read]}" | median)
-memory_sys=$(echo "${syss[memory]}" | median)
-awk -v p="$points" -v u="$ours_user" -v s="$ours_sys" -v r="$read_sys" -v w="$write_sys" -v o="$omh_read_sys" -v m="$memory_sys" 'BEGIN {
+declare -A sys_median
+for step in "${!syss[@]}"; do
+  sys_median[$step]=$(echo "${syss[$step]}" | median)
+done
+awk -v p="$points" -v u="$(echo "${users[ours]}" | median)" -v s="${sys_median[ours]}" \
+    -v r="${sys_median[read]}" -v w="${sys_median[write]}" -v o="${sys_median[omh_read]}" \
+    -v m="${sys_median[memory]}" 'BEGIN {
   w = (w > o) ? w - o : 0
   floor = r + w + m
   printf "bench=kernel_floor summary points=%d ours_user_s=%.2f ours_sys_s=%.2f read_sys_s=%.2f write_sys_s=%.2f memory_sys_s=%.2f floor_sys_s=%.2f ours_share=%.2f floor_share=%.2f ours_over_floor_sys=%.2f\n",
