@@ -67,13 +67,23 @@ void* mapAnonymous(std::size_t bytes) {
     return memory;
 }
 
+// Faults in [memory, memory + bytes) with one MADV_POPULATE_WRITE; false (said on stderr) when
+// the kernel refuses.
+bool populate(void* memory, std::size_t bytes) {
+    if (madvise(memory, bytes, MADV_POPULATE_WRITE) != 0) {
+        std::fprintf(stderr, "page_cost_bench: MADV_POPULATE_WRITE: %s\n", std::strerror(errno));
+        return false;
+    }
+    return true;
+}
+
 // Writes `bytes` of `source` into fresh anonymous memory, optionally populated first.
-Figure fillFresh(const std::uint8_t* source, std::size_t bytes, bool populate) {
+Figure fillFresh(const std::uint8_t* source, std::size_t bytes, bool populateFirst) {
     const long faultsBefore = minorFaults();
     const auto start = Clock::now();
     auto* memory = static_cast<std::uint8_t*>(mapAnonymous(bytes));
-    if (populate && madvise(memory, bytes, MADV_POPULATE_WRITE) != 0) {
-        std::fprintf(stderr, "page_cost_bench: MADV_POPULATE_WRITE: %s\n", std::strerror(errno));
+    if (populateFirst) {
+        populate(memory, bytes);
     }
     std::memcpy(memory, source, bytes);
     Figure figure{secondsSince(start), minorFaults() - faultsBefore};
@@ -125,9 +135,7 @@ int main(int argc, char** argv) {
         const long faultsBefore = minorFaults();
         const auto start = Clock::now();
         void* memory = mapAnonymous(bytes);
-        if (madvise(memory, bytes, MADV_POPULATE_WRITE) != 0) {
-            std::fprintf(stderr, "page_cost_bench: MADV_POPULATE_WRITE: %s\n",
-                         std::strerror(errno));
+        if (!populate(memory, bytes)) {
             return 1;
         }
         print("populate_only", bytes, {secondsSince(start), minorFaults() - faultsBefore});

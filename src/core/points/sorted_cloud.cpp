@@ -1,9 +1,25 @@
 #include "points/sorted_cloud.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 
 namespace omicron {
+
+namespace {
+
+// `values` as the first elements of `array`: a file-backed array is written as the staged ranges
+// are (its mapping reads it back), the rest of its reserved space staying unused.
+template <typename T> void storeFirst(HugePageArray<T>& array, std::span<const T> values) {
+    assert(array.size() >= values.size());
+    if (array.fileBacked()) {
+        array.writeAt(0, values);
+    } else {
+        std::copy(values.begin(), values.end(), array.data());
+    }
+}
+
+} // namespace
 
 const char* toString(PointStorage storage) {
     return storage == PointStorage::Packed ? "packed" : "exact";
@@ -78,24 +94,12 @@ SortedCloud::InPlaceArrays SortedCloud::inPlaceArrays() {
 
 void SortedCloud::setUniformColumns(const std::uint16_t* intensity, const std::uint8_t* lasRecord) {
     assert(m_sortedEnd.load(std::memory_order_relaxed) == 0);
-    // A file-backed array is written as the staged ranges are (its mapping reads it back);
-    // the rest of its reserved space stays unused.
     if (intensity != nullptr) {
-        assert(m_intensities.size() != 0);
-        if (fileBacked()) {
-            m_intensities.writeAt(0, std::span(intensity, 1));
-        } else {
-            m_intensities.data()[0] = *intensity;
-        }
+        storeFirst(m_intensities, std::span(intensity, 1));
         m_intensityStride = 0;
     }
     if (lasRecord != nullptr) {
-        assert(m_las.size() != 0);
-        if (fileBacked()) {
-            m_las.writeAt(0, std::span(lasRecord, m_attributes.lasBytes()));
-        } else {
-            std::memcpy(m_las.data(), lasRecord, m_attributes.lasBytes());
-        }
+        storeFirst(m_las, std::span(lasRecord, m_attributes.lasBytes()));
         m_lasStride = 0;
     }
 }

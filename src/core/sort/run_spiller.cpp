@@ -58,14 +58,14 @@ void RunSpiller::add(const PointBatch& batch, std::span<const morton::Code> code
         m_codes.insert(m_codes.end(), codes.begin() + first, codes.begin() + first + take);
         first += take;
         if (m_buffer.size() == m_runPoints) {
-            startSpill(m_layout.without(uniform.intensity, uniform.las));
+            startSpill();
         }
     }
 }
 
 void RunSpiller::finish() {
     if (!m_buffer.empty()) {
-        startSpill(m_layout.without(m_uniform.intensity, m_uniform.las));
+        startSpill();
     }
     collectSpill();
     // The buffers' memory goes back before the merge needs its own.
@@ -85,7 +85,8 @@ void RunSpiller::collectSpill() {
     }
 }
 
-void RunSpiller::startSpill(const PointRecordLayout& layout) {
+void RunSpiller::startSpill() {
+    const PointRecordLayout layout = m_layout.without(m_uniform.intensity, m_uniform.las);
     collectSpill(); // the other buffer is free again
     std::swap(m_buffer, m_spilled);
     std::swap(m_codes, m_spilledCodes);

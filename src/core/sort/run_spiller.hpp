@@ -72,8 +72,8 @@ public:
 
 private:
     // Waits for the run being written (rethrowing its error) and hands the full buffer to a
-    // thread that sorts and writes it with `layout`.
-    void startSpill(const PointRecordLayout& layout);
+    // thread that sorts and writes it, without the columns m_uniform says are uniform so far.
+    void startSpill();
     // Waits for the run being written, if any, and adds it to m_runs; rethrows its error.
     void collectSpill();
     // The spilling thread: sorts m_spilled by m_spilledCodes and writes it as run `index`.
