@@ -132,6 +132,7 @@ struct AttributeCopy {
 
 using Intensity = FloatRecordLayout::Intensity;
 using Color = FloatRecordLayout::Color;
+using Normals = FloatRecordLayout::Normals;
 
 // A ushort colour channel as 8 bits: plyColorChannel's round(v / 257) in integers (v / 257 is
 // never within 1/514 of a half, so the two agree for every v).
@@ -141,16 +142,20 @@ inline std::uint8_t colorByte(const std::uint8_t* at) {
     return static_cast<std::uint8_t>((2u * v + 257u) / 514u);
 }
 
-// The optional float normal, uchar colour and ushort or float intensity of record r, shared by both
-// conversions. Only present arrays are indexed: arithmetic on an absent array's null pointer is
-// undefined behaviour (found by fuzz_ply under UBSan).
-template <bool kNormals, Color kColor, Intensity kIntensity>
+// The optional float or double normal, uchar or ushort colour and ushort or float intensity of
+// record r, shared by both conversions. Only present arrays are indexed: arithmetic on an absent
+// array's null pointer is undefined behaviour (found by fuzz_ply under UBSan).
+template <Normals kNormals, Color kColor, Intensity kIntensity>
 inline void copyOptionalAttributes(const std::uint8_t* record, std::size_t r,
                                    const AttributeCopy& copy) {
-    if constexpr (kNormals) {
+    if constexpr (kNormals == Normals::Float) {
         copy.normals[r] =
             glm::vec3(loadFloat(record + copy.normalAt[0]), loadFloat(record + copy.normalAt[1]),
                       loadFloat(record + copy.normalAt[2]));
+    } else if constexpr (kNormals == Normals::Double) {
+        copy.normals[r] = glm::vec3(glm::dvec3(loadDouble(record + copy.normalAt[0]),
+                                               loadDouble(record + copy.normalAt[1]),
+                                               loadDouble(record + copy.normalAt[2])));
     }
     if constexpr (kColor == Color::UChar) {
         copy.colors[r] =
@@ -172,7 +177,7 @@ AttributeCopy attributeCopy(const FloatRecordLayout& layout, const FloatRecordOu
             outputs.normals, outputs.colors, outputs.intensities};
 }
 
-template <bool kNormals, Color kColor, Intensity kIntensity>
+template <Normals kNormals, Color kColor, Intensity kIntensity>
 std::size_t convertScalar(const std::uint8_t* records, std::size_t count,
                           const FloatRecordLayout& layout, const FloatUnitTransform& transform,
                           const FloatRecordOutputs& outputs) {
@@ -250,7 +255,7 @@ void extendSse2(const std::uint8_t* records, std::size_t count, const FloatRecor
     box.finite += finite;
 }
 
-template <bool kNormals, Color kColor, Intensity kIntensity>
+template <Normals kNormals, Color kColor, Intensity kIntensity>
 std::size_t convertSse2(const std::uint8_t* records, std::size_t count,
                         const FloatRecordLayout& layout, const FloatUnitTransform& transform,
                         const FloatRecordOutputs& outputs) {
@@ -292,7 +297,7 @@ std::size_t convertSse2(const std::uint8_t* records, std::size_t count,
 
 #endif
 
-template <bool kNormals, Color kColor, Intensity kIntensity>
+template <Normals kNormals, Color kColor, Intensity kIntensity>
 std::size_t convert(const std::uint8_t* records, std::size_t count, const FloatRecordLayout& layout,
                     const FloatUnitTransform& transform, const FloatRecordOutputs& outputs) {
 #if defined(__SSE2__)
@@ -306,7 +311,7 @@ std::size_t convert(const std::uint8_t* records, std::size_t count, const FloatR
 
 // Double x y z, as PDAL writes them: source = x + offset and the normalizer's own checks,
 // point by point, as the general path does (no float prefilter box to find).
-template <bool kNormals, Color kColor, Intensity kIntensity>
+template <Normals kNormals, Color kColor, Intensity kIntensity>
 std::size_t convertDoubles(const std::uint8_t* records, std::size_t count,
                            const FloatRecordLayout& layout, const SourceNormalizer& normalizer,
                            const glm::dvec3& offset, const FloatRecordOutputs& outputs) {
@@ -332,7 +337,7 @@ std::size_t convertDoubles(const std::uint8_t* records, std::size_t count,
 // optional attributes: one instantiation of a conversion loop per combination.
 template <typename Convert>
 std::size_t forLayoutAttributes(const FloatRecordLayout& layout, const Convert& convert) {
-    const auto withIntensity = [&]<bool kNormals, Color kColor>() -> std::size_t {
+    const auto withIntensity = [&]<Normals kNormals, Color kColor>() -> std::size_t {
         switch (layout.intensityType) {
         case Intensity::UShort:
             return convert.template operator()<kNormals, kColor, Intensity::UShort>();
@@ -343,7 +348,7 @@ std::size_t forLayoutAttributes(const FloatRecordLayout& layout, const Convert& 
         }
         return convert.template operator()<kNormals, kColor, Intensity::None>();
     };
-    const auto withColor = [&]<bool kNormals>() -> std::size_t {
+    const auto withColor = [&]<Normals kNormals>() -> std::size_t {
         switch (layout.colorType) {
         case Color::UChar:
             return withIntensity.template operator()<kNormals, Color::UChar>();
@@ -354,8 +359,15 @@ std::size_t forLayoutAttributes(const FloatRecordLayout& layout, const Convert& 
         }
         return withIntensity.template operator()<kNormals, Color::None>();
     };
-    return layout.hasNormals ? withColor.template operator()<true>()
-                             : withColor.template operator()<false>();
+    switch (layout.normalType) {
+    case Normals::Float:
+        return withColor.template operator()<Normals::Float>();
+    case Normals::Double:
+        return withColor.template operator()<Normals::Double>();
+    case Normals::None:
+        break;
+    }
+    return withColor.template operator()<Normals::None>();
 }
 
 } // namespace
@@ -375,7 +387,7 @@ std::size_t convertFloatRecords(const std::uint8_t* records, std::size_t count,
                                 const FloatRecordLayout& layout,
                                 const FloatUnitTransform& transform,
                                 const FloatRecordOutputs& outputs) {
-    return forLayoutAttributes(layout, [&]<bool kNormals, Color kColor, Intensity kIntensity>() {
+    return forLayoutAttributes(layout, [&]<Normals kNormals, Color kColor, Intensity kIntensity>() {
         return convert<kNormals, kColor, kIntensity>(records, count, layout, transform, outputs);
     });
 }
@@ -411,7 +423,7 @@ std::size_t convertDoubleRecords(const std::uint8_t* records, std::size_t count,
                                  const FloatRecordLayout& layout,
                                  const SourceNormalizer& normalizer, const glm::dvec3& offset,
                                  const FloatRecordOutputs& outputs) {
-    return forLayoutAttributes(layout, [&]<bool kNormals, Color kColor, Intensity kIntensity>() {
+    return forLayoutAttributes(layout, [&]<Normals kNormals, Color kColor, Intensity kIntensity>() {
         return convertDoubles<kNormals, kColor, kIntensity>(records, count, layout, normalizer,
                                                             offset, outputs);
     });

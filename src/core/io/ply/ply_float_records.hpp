@@ -1,8 +1,8 @@
 // Hot loops for the common binary PLY layout: native-endian float (or double) x y z, optionally
-// float normals, uchar or ushort colours and a ushort or float intensity, no lists. Both loops do
-// only loads, a few compares and the SourceNormalizer arithmetic, with an SSE2 path when x y z are
-// adjacent; everything unusual (non-finite points, points at or outside the bounds) is left to the
-// caller's exact code.
+// float or double normals, uchar or ushort colours and a ushort or float intensity, no lists.
+// Both loops do only loads, a few compares and the SourceNormalizer arithmetic, with an SSE2
+// path when x y z are adjacent floats; everything unusual (non-finite points, points at or
+// outside the bounds) is left to the caller's exact code.
 #pragma once
 
 #include "io/source_normalizer.hpp"
@@ -23,8 +23,10 @@ struct FloatRecordLayout {
     std::size_t recordBytes = 0;
     std::array<std::size_t, 3> position{}; // byte offsets of x y z (float, or double below)
     bool doublePositions = false;          // the double loops: extendDoubleBounds, convertDouble…
-    bool hasNormals = false;
-    std::array<std::size_t, 3> normal{}; // float
+    // float, or double (Open3D writes double normals; read as the general code does, rounded
+    // to float)
+    enum class Normals { None, Float, Double } normalType = Normals::None;
+    std::array<std::size_t, 3> normal{};
     // uchar (copied), or ushort (scaled to 8 bits as plyColorChannel: PDAL writes LAS colours so)
     enum class Color { None, UChar, UShort } colorType = Color::None;
     std::array<std::size_t, 3> color{};

@@ -767,11 +767,13 @@ bool PlyReader::intensityOnFastPath() const {
 }
 
 // The layout of ../shared/data, most scanners, CloudCompare, PDAL (double positions, ushort
-// colours) and our own converter: float or double positions, optionally float normals, uchar
-// or ushort colours and a ushort or float intensity.
+// colours), Open3D (double positions and normals) and our own converter: float or double
+// positions, optionally float or double normals, uchar or ushort colours and a ushort or float
+// intensity.
 bool PlyReader::fastLayout() const {
     return fastPositions() &&
-           (!m_fields.hasNormals() || hasType(m_fields.normal, PlyScalarType::Float32)) &&
+           (!m_fields.hasNormals() || hasType(m_fields.normal, PlyScalarType::Float32) ||
+            hasType(m_fields.normal, PlyScalarType::Float64)) &&
            (!m_fields.hasColors() || hasType(m_fields.color, PlyScalarType::UInt8) ||
             hasType(m_fields.color, PlyScalarType::UInt16)) &&
            intensityOnFastPath();
@@ -790,7 +792,11 @@ FloatRecordLayout PlyReader::floatLayout() const {
             layout.color[axis] = m_propertyOffsets[m_fields.color[axis]];
         }
     }
-    layout.hasNormals = m_fields.hasNormals();
+    if (m_fields.hasNormals()) {
+        layout.normalType = hasType(m_fields.normal, PlyScalarType::Float32)
+                                ? FloatRecordLayout::Normals::Float
+                                : FloatRecordLayout::Normals::Double;
+    }
     if (m_fields.hasColors()) {
         layout.colorType = hasType(m_fields.color, PlyScalarType::UInt8)
                                ? FloatRecordLayout::Color::UChar
@@ -930,7 +936,9 @@ bool PlyReader::readFastLayout(const SourceNormalizer& normalizer, BatchSink& si
                 const std::size_t take = std::min(count - done, sink.room());
                 FloatRecordOutputs outputs;
                 outputs.positions = batch.positions.data() + slot;
-                outputs.normals = layout.hasNormals ? batch.normals.data() + slot : nullptr;
+                outputs.normals = layout.normalType != FloatRecordLayout::Normals::None
+                                      ? batch.normals.data() + slot
+                                      : nullptr;
                 outputs.colors = layout.colorType != FloatRecordLayout::Color::None
                                      ? batch.colors.data() + slot
                                      : nullptr;

@@ -788,6 +788,54 @@ TEST(PlyReaderLayout, UShortColoursOnTheFastPathAgreeWithTheGeneralOne) {
     EXPECT_EQ(fast.points.colors[128], glm::u8vec3(1, 254, 150));
 }
 
+// Open3D's point cloud PLY: double x y z, double nx ny nz and uchar colours. The fast loops
+// (float positions too, for the float loops with double normals) round each double normal to
+// float as the general code does, little- and big-endian, bit for bit.
+TEST(PlyReaderLayout, DoubleNormalsOnTheFastPathAgreeWithTheGeneralOne) {
+    for (const char* position : {"double", "float"}) {
+        SCOPED_TRACE(position);
+        const std::string p = position;
+        const std::string properties =
+            "property " + p + " x\nproperty " + p + " y\nproperty " + p +
+            " z\nproperty double nx\nproperty double ny\nproperty double nz\n"
+            "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+        constexpr std::size_t kPoints = 40'000;
+        test::TempDir dir;
+        ThreeEncodings files([&](const char* format, const std::string& more) {
+            return binaryHeader(kPoints, properties + more, format);
+        });
+        for (std::size_t i = 0; i < kPoints; ++i) {
+            const double x = 10.0 + 0.01 * static_cast<double>(i % 200);
+            const double y = -5.0 + 0.02 * static_cast<double>(i / 200);
+            const double z = i % 4999 == 3 ? std::numeric_limits<double>::quiet_NaN()
+                                           : std::cos(1e-3 * static_cast<double>(i));
+            // Doubles that floats cannot hold (a third, a tenth, a value one part in 2^40
+            // off), some past the float range's small end, and unnormalised ones.
+            const double angle = 1e-3 * static_cast<double>(i);
+            const glm::dvec3 normal(std::sin(angle) / 3.0, 0.1 + std::ldexp(1.0, -40),
+                                    i % 3 == 0 ? 1e-300 : std::cos(angle) * 7.0);
+            files.vertex([&](PlyBytes& bytes) {
+                if (p == "double") {
+                    bytes.put(x).put(y).put(z);
+                } else {
+                    bytes.put(static_cast<float>(x)).put(static_cast<float>(y));
+                    bytes.put(static_cast<float>(z));
+                }
+                bytes.put(normal.x).put(normal.y).put(normal.z);
+                bytes.put(std::uint8_t(i % 256)).put(std::uint8_t(3)).put(std::uint8_t(200));
+            });
+        }
+        const ReadResult fast = files.readAll(dir);
+        ASSERT_TRUE(fast.info.attributes.has(Attribute::Normal));
+        EXPECT_EQ(fast.summary.skippedNonFinite, 9u); // i = 3, 5002, ..., 39995
+        ASSERT_EQ(fast.points.size(), kPoints - 9);
+        EXPECT_EQ(fast.points.normals[0],
+                  glm::vec3(0.0f, static_cast<float>(0.1 + std::ldexp(1.0, -40)), 0.0f));
+        EXPECT_EQ(fast.points.normals[1].x, static_cast<float>(std::sin(1e-3) / 3.0));
+        EXPECT_EQ(fast.points.colors[1], glm::u8vec3(1, 3, 200));
+    }
+}
+
 TEST(PlyReaderLayout, CrlfHeaderAndBody) {
     test::TempDir dir;
     const std::string binaryPath = dir.file("crlf.ply");
