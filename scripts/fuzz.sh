@@ -36,7 +36,8 @@ seed() { # target, files...
     [ -f "$file" ] && cp "$file" "$work/corpus-$target/" || true
   done
 }
-seed ply "$shared"/bunny.ply "$shared"/lion.ply "$shared"/sorvilier.ply "$shared"/autzen_trim.ply
+seed ply "$shared"/bunny.ply "$shared"/lion.ply "$shared"/sorvilier.ply "$shared"/autzen_trim.ply \
+  fuzz/seeds-ply/*
 seed las "$shared"/autzen_trim.las "$shared"/laz/simple.las "$shared"/laz/1.2-with-color.copc.las
 seed laz "$shared"/laz/simple.laz "$shared"/laz/1.2-with-color.copc.laz "$shared"/laz/autzen_trim.laz \
   tests/data/laz/simple-laszip-v1.laz tests/data/laz/waveform-format4.laz \
