@@ -142,9 +142,9 @@ inline std::uint8_t colorByte(const std::uint8_t* at) {
     return static_cast<std::uint8_t>((2u * v + 257u) / 514u);
 }
 
-// The optional float or double normal, uchar or ushort colour and ushort or float intensity of
-// record r, shared by both conversions. Only present arrays are indexed: arithmetic on an absent
-// array's null pointer is undefined behaviour (found by fuzz_ply under UBSan).
+// The optional float or double normal, uchar, ushort or float colour and ushort or float
+// intensity of record r, shared by both conversions. Only present arrays are indexed: arithmetic on
+// an absent array's null pointer is undefined behaviour (found by fuzz_ply under UBSan).
 template <Normals kNormals, Color kColor, Intensity kIntensity>
 inline void copyOptionalAttributes(const std::uint8_t* record, std::size_t r,
                                    const AttributeCopy& copy) {
@@ -164,6 +164,11 @@ inline void copyOptionalAttributes(const std::uint8_t* record, std::size_t r,
         copy.colors[r] =
             glm::u8vec3(colorByte(record + copy.colorAt[0]), colorByte(record + copy.colorAt[1]),
                         colorByte(record + copy.colorAt[2]));
+    } else if constexpr (kColor == Color::Float) {
+        copy.colors[r] = glm::u8vec3(
+            plyColorChannel(loadFloat(record + copy.colorAt[0]), PlyScalarType::Float32),
+            plyColorChannel(loadFloat(record + copy.colorAt[1]), PlyScalarType::Float32),
+            plyColorChannel(loadFloat(record + copy.colorAt[2]), PlyScalarType::Float32));
     }
     if constexpr (kIntensity == Intensity::UShort) {
         std::memcpy(&copy.intensities[r], record + copy.intensityAt, sizeof(std::uint16_t));
@@ -354,6 +359,8 @@ std::size_t forLayoutAttributes(const FloatRecordLayout& layout, const Convert& 
             return withIntensity.template operator()<kNormals, Color::UChar>();
         case Color::UShort:
             return withIntensity.template operator()<kNormals, Color::UShort>();
+        case Color::Float:
+            return withIntensity.template operator()<kNormals, Color::Float>();
         case Color::None:
             break;
         }

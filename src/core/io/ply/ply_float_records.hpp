@@ -1,5 +1,6 @@
 // Hot loops for the common binary PLY layout: native-endian float (or double) x y z, optionally
-// float or double normals, uchar or ushort colours and a ushort or float intensity, no lists.
+// float or double normals, uchar, ushort or float colours and a ushort or float intensity, no
+// lists.
 // Both loops do only loads, a few compares and the SourceNormalizer arithmetic, with an SSE2
 // path when x y z are adjacent floats; everything unusual (non-finite points, points at or
 // outside the bounds) is left to the caller's exact code.
@@ -27,8 +28,9 @@ struct FloatRecordLayout {
     // to float)
     enum class Normals { None, Float, Double } normalType = Normals::None;
     std::array<std::size_t, 3> normal{};
-    // uchar (copied), or ushort (scaled to 8 bits as plyColorChannel: PDAL writes LAS colours so)
-    enum class Color { None, UChar, UShort } colorType = Color::None;
+    // uchar (copied), ushort (scaled to 8 bits as plyColorChannel: PDAL writes LAS colours so)
+    // or float (0 to 1, scaled to 8 bits as plyColorChannel)
+    enum class Color { None, UChar, UShort, Float } colorType = Color::None;
     std::array<std::size_t, 3> color{};
     // ushort (copied), or float (rounded and clamped as plyIntensity: CloudCompare's
     // scalar_Intensity)

@@ -768,14 +768,15 @@ bool PlyReader::intensityOnFastPath() const {
 
 // The layout of ../shared/data, most scanners, CloudCompare, PDAL (double positions, ushort
 // colours), Open3D (double positions and normals) and our own converter: float or double
-// positions, optionally float or double normals, uchar or ushort colours and a ushort or float
-// intensity.
+// positions, optionally float or double normals, uchar, ushort or float colours and a ushort or
+// float intensity.
 bool PlyReader::fastLayout() const {
     return fastPositions() &&
            (!m_fields.hasNormals() || hasType(m_fields.normal, PlyScalarType::Float32) ||
             hasType(m_fields.normal, PlyScalarType::Float64)) &&
            (!m_fields.hasColors() || hasType(m_fields.color, PlyScalarType::UInt8) ||
-            hasType(m_fields.color, PlyScalarType::UInt16)) &&
+            hasType(m_fields.color, PlyScalarType::UInt16) ||
+            hasType(m_fields.color, PlyScalarType::Float32)) &&
            intensityOnFastPath();
 }
 
@@ -798,9 +799,10 @@ FloatRecordLayout PlyReader::floatLayout() const {
                                 : FloatRecordLayout::Normals::Double;
     }
     if (m_fields.hasColors()) {
-        layout.colorType = hasType(m_fields.color, PlyScalarType::UInt8)
-                               ? FloatRecordLayout::Color::UChar
-                               : FloatRecordLayout::Color::UShort;
+        layout.colorType =
+            hasType(m_fields.color, PlyScalarType::UInt8)    ? FloatRecordLayout::Color::UChar
+            : hasType(m_fields.color, PlyScalarType::UInt16) ? FloatRecordLayout::Color::UShort
+                                                             : FloatRecordLayout::Color::Float;
     }
     if (m_fields.hasIntensity()) {
         layout.intensityType = vertex().properties[m_fields.intensity].type == PlyScalarType::UInt16

@@ -836,6 +836,59 @@ TEST(PlyReaderLayout, DoubleNormalsOnTheFastPathAgreeWithTheGeneralOne) {
     }
 }
 
+// Float colours from 0 to 1 (beside float positions, and double ones): the fast loops scale
+// them to 8 bits as the general code does, values outside [0, 1], NaN and the roundings at
+// half a step included, little- and big-endian.
+TEST(PlyReaderLayout, FloatColoursOnTheFastPathAgreeWithTheGeneralOne) {
+    for (const char* position : {"float", "double"}) {
+        SCOPED_TRACE(position);
+        const std::string p = position;
+        const std::string properties = "property " + p + " x\nproperty " + p + " y\nproperty " + p +
+                                       " z\nproperty float red\nproperty float green\n"
+                                       "property float blue\n";
+        constexpr std::size_t kPoints = 20'000;
+        test::TempDir dir;
+        ThreeEncodings files([&](const char* format, const std::string& more) {
+            return binaryHeader(kPoints, properties + more, format);
+        });
+        const auto channel = [](std::size_t i) {
+            switch (i % 5) {
+            case 0:
+                return static_cast<float>(i % 256) / 255.0f;
+            case 1:
+                return (static_cast<float>(i % 256) + 0.5f) / 255.0f; // half a step
+            case 2:
+                return i % 2 == 0 ? -0.25f : 1.75f;
+            case 3:
+                return std::numeric_limits<float>::quiet_NaN();
+            default:
+                return std::nextafter(1.0f, 0.0f);
+            }
+        };
+        for (std::size_t i = 0; i < kPoints; ++i) {
+            const double x = 3.0 + 0.5 * static_cast<double>(i % 100);
+            const double y = 4.0 + 0.5 * static_cast<double>(i / 100);
+            const double z = 1.0;
+            files.vertex([&](PlyBytes& bytes) {
+                if (p == "double") {
+                    bytes.put(x).put(y).put(z);
+                } else {
+                    bytes.put(static_cast<float>(x)).put(static_cast<float>(y));
+                    bytes.put(static_cast<float>(z));
+                }
+                bytes.put(channel(i)).put(channel(i + 1)).put(channel(i + 2));
+            });
+        }
+        const ReadResult fast = files.readAll(dir);
+        ASSERT_TRUE(fast.info.attributes.has(Attribute::Color));
+        ASSERT_EQ(fast.points.size(), kPoints);
+        // Point 0: 0, 1.5 / 255 (half a step: rounds up to 2), -0.25 (clamped to 0); point 3:
+        // NaN (0), 1 - ulp (255), 5 / 255.
+        EXPECT_EQ(fast.points.colors[0], glm::u8vec3(0, 2, 0));
+        EXPECT_EQ(fast.points.colors[3], glm::u8vec3(0, 255, 5));
+    }
+}
+
 TEST(PlyReaderLayout, CrlfHeaderAndBody) {
     test::TempDir dir;
     const std::string binaryPath = dir.file("crlf.ply");
