@@ -788,16 +788,29 @@ TEST(PlyReaderLayout, UShortColoursOnTheFastPathAgreeWithTheGeneralOne) {
     EXPECT_EQ(fast.points.colors[128], glm::u8vec3(1, 254, 150));
 }
 
+// "property TYPE x" ... z, for tests run with float and with double positions.
+std::string positionProperties(const std::string& type) {
+    return "property " + type + " x\nproperty " + type + " y\nproperty " + type + " z\n";
+}
+
+// x y z stored as `type` (float or double).
+void putPosition(PlyBytes& bytes, const std::string& type, double x, double y, double z) {
+    if (type == "double") {
+        bytes.put(x).put(y).put(z);
+    } else {
+        bytes.put(static_cast<float>(x)).put(static_cast<float>(y)).put(static_cast<float>(z));
+    }
+}
+
 // Open3D's point cloud PLY: double x y z, double nx ny nz and uchar colours. The fast loops
 // (float positions too, for the float loops with double normals) round each double normal to
 // float as the general code does, little- and big-endian, bit for bit.
 TEST(PlyReaderLayout, DoubleNormalsOnTheFastPathAgreeWithTheGeneralOne) {
     for (const char* position : {"double", "float"}) {
         SCOPED_TRACE(position);
-        const std::string p = position;
         const std::string properties =
-            "property " + p + " x\nproperty " + p + " y\nproperty " + p +
-            " z\nproperty double nx\nproperty double ny\nproperty double nz\n"
+            positionProperties(position) +
+            "property double nx\nproperty double ny\nproperty double nz\n"
             "property uchar red\nproperty uchar green\nproperty uchar blue\n";
         constexpr std::size_t kPoints = 40'000;
         test::TempDir dir;
@@ -815,12 +828,7 @@ TEST(PlyReaderLayout, DoubleNormalsOnTheFastPathAgreeWithTheGeneralOne) {
             const glm::dvec3 normal(std::sin(angle) / 3.0, 0.1 + std::ldexp(1.0, -40),
                                     i % 3 == 0 ? 1e-300 : std::cos(angle) * 7.0);
             files.vertex([&](PlyBytes& bytes) {
-                if (p == "double") {
-                    bytes.put(x).put(y).put(z);
-                } else {
-                    bytes.put(static_cast<float>(x)).put(static_cast<float>(y));
-                    bytes.put(static_cast<float>(z));
-                }
+                putPosition(bytes, position, x, y, z);
                 bytes.put(normal.x).put(normal.y).put(normal.z);
                 bytes.put(std::uint8_t(i % 256)).put(std::uint8_t(3)).put(std::uint8_t(200));
             });
@@ -842,10 +850,9 @@ TEST(PlyReaderLayout, DoubleNormalsOnTheFastPathAgreeWithTheGeneralOne) {
 TEST(PlyReaderLayout, FloatColoursOnTheFastPathAgreeWithTheGeneralOne) {
     for (const char* position : {"float", "double"}) {
         SCOPED_TRACE(position);
-        const std::string p = position;
-        const std::string properties = "property " + p + " x\nproperty " + p + " y\nproperty " + p +
-                                       " z\nproperty float red\nproperty float green\n"
-                                       "property float blue\n";
+        const std::string properties =
+            positionProperties(position) +
+            "property float red\nproperty float green\nproperty float blue\n";
         constexpr std::size_t kPoints = 20'000;
         test::TempDir dir;
         ThreeEncodings files([&](const char* format, const std::string& more) {
@@ -870,12 +877,7 @@ TEST(PlyReaderLayout, FloatColoursOnTheFastPathAgreeWithTheGeneralOne) {
             const double y = 4.0 + 0.5 * static_cast<double>(i / 100);
             const double z = 1.0;
             files.vertex([&](PlyBytes& bytes) {
-                if (p == "double") {
-                    bytes.put(x).put(y).put(z);
-                } else {
-                    bytes.put(static_cast<float>(x)).put(static_cast<float>(y));
-                    bytes.put(static_cast<float>(z));
-                }
+                putPosition(bytes, position, x, y, z);
                 bytes.put(channel(i)).put(channel(i + 1)).put(channel(i + 2));
             });
         }
