@@ -143,8 +143,9 @@ inline std::uint8_t colorByte(const std::uint8_t* at) {
 }
 
 // The optional float or double normal, uchar, ushort or float colour and ushort or float
-// intensity of record r, shared by both conversions. Only present arrays are indexed: arithmetic on
-// an absent array's null pointer is undefined behaviour (found by fuzz_ply under UBSan).
+// intensity of record r, shared by both conversions. Only present arrays are indexed:
+// arithmetic on an absent array's null pointer is undefined behaviour (found by fuzz_ply under
+// UBSan).
 template <Normals kNormals, Color kColor, Intensity kIntensity>
 inline void copyOptionalAttributes(const std::uint8_t* record, std::size_t r,
                                    const AttributeCopy& copy) {
