@@ -35,7 +35,8 @@ cp "$work/out.omh" "$work/reference.omh"
 peak_mib=$(((peak_kib + 1023) / 1024))
 echo "bench=kernel_floor step=input cloud=$(basename "$cloud") copies=$copies points=$points bytes=$(stat -c %s "$input") omh_bytes=$(stat -c %s "$work/reference.omh") peak_rss_mib=$peak_mib"
 
-declare -A users syss
+ours_users=""
+declare -A syss
 for run in $(seq 1 "$runs"); do
   for step in ours read write omh_read memory; do
     case $step in
@@ -49,7 +50,7 @@ for run in $(seq 1 "$runs"); do
       memory) read -r wall user sys rss < <(measure "$page_cost" --mib "$peak_mib" --populate-only) ;;
     esac
     echo "bench=kernel_floor step=$step run=$run wall_s=$wall user_s=$user sys_s=$sys peak_rss_mib=$((rss / 1024))"
-    users[$step]+="$user "
+    [ "$step" = ours ] && ours_users+="$user "
     syss[$step]+="$sys "
   done
 done
@@ -58,7 +59,7 @@ declare -A sys_median
 for step in "${!syss[@]}"; do
   sys_median[$step]=$(echo "${syss[$step]}" | median)
 done
-awk -v p="$points" -v u="$(echo "${users[ours]}" | median)" -v s="${sys_median[ours]}" \
+awk -v p="$points" -v u="$(echo "$ours_users" | median)" -v s="${sys_median[ours]}" \
     -v r="${sys_median[read]}" -v w="${sys_median[write]}" -v o="${sys_median[omh_read]}" \
     -v m="${sys_median[memory]}" 'BEGIN {
   w = (w > o) ? w - o : 0

@@ -1,8 +1,7 @@
 // Hot loops for the common binary PLY layout: native-endian float (or double) x y z, optionally
 // float or double normals, uchar, ushort or float colours and a ushort or float intensity, no
-// lists.
-// Both loops do only loads, a few compares and the SourceNormalizer arithmetic, with an SSE2
-// path when x y z are adjacent floats; everything unusual (non-finite points, points at or
+// lists. Both loops do only loads, a few compares and the SourceNormalizer arithmetic, with an
+// SSE2 path when x y z are adjacent floats; everything unusual (non-finite points, points at or
 // outside the bounds) is left to the caller's exact code.
 #pragma once
 

@@ -211,7 +211,11 @@ private:
     void toNativeOrder(std::uint8_t* records, std::size_t count) const;
     bool hasType(const std::array<int, 3>& fields, PlyScalarType type) const;
     bool fastPositions() const;
-    bool intensityOnFastPath() const;
+    // The fast loops' type of each optional attribute (None when the file has none), or
+    // nullopt when they do not read the file's type.
+    std::optional<FloatRecordLayout::Normals> fastNormals() const;
+    std::optional<FloatRecordLayout::Color> fastColors() const;
+    std::optional<FloatRecordLayout::Intensity> fastIntensity() const;
     bool fastLayout() const;
     FloatRecordLayout floatLayout() const;
     void scanFixedRecordBounds(PrePassMonitor& monitor, Bounds& bounds, std::uint64_t& finite);
@@ -758,12 +762,50 @@ bool PlyReader::fastPositions() const {
             hasType(m_fields.position, PlyScalarType::Float64));
 }
 
-bool PlyReader::intensityOnFastPath() const {
-    if (!m_fields.hasIntensity()) {
-        return true;
+std::optional<FloatRecordLayout::Normals> PlyReader::fastNormals() const {
+    using Normals = FloatRecordLayout::Normals;
+    if (!m_fields.hasNormals()) {
+        return Normals::None;
     }
-    const PlyScalarType type = vertex().properties[m_fields.intensity].type;
-    return type == PlyScalarType::UInt16 || type == PlyScalarType::Float32;
+    if (hasType(m_fields.normal, PlyScalarType::Float32)) {
+        return Normals::Float;
+    }
+    if (hasType(m_fields.normal, PlyScalarType::Float64)) {
+        return Normals::Double;
+    }
+    return std::nullopt;
+}
+
+std::optional<FloatRecordLayout::Color> PlyReader::fastColors() const {
+    using Color = FloatRecordLayout::Color;
+    if (!m_fields.hasColors()) {
+        return Color::None;
+    }
+    if (hasType(m_fields.color, PlyScalarType::UInt8)) {
+        return Color::UChar;
+    }
+    if (hasType(m_fields.color, PlyScalarType::UInt16)) {
+        return Color::UShort;
+    }
+    if (hasType(m_fields.color, PlyScalarType::Float32)) {
+        return Color::Float;
+    }
+    return std::nullopt;
+}
+
+std::optional<FloatRecordLayout::Intensity> PlyReader::fastIntensity() const {
+    using Intensity = FloatRecordLayout::Intensity;
+    if (!m_fields.hasIntensity()) {
+        return Intensity::None;
+    }
+    switch (vertex().properties[m_fields.intensity].type) {
+    case PlyScalarType::UInt16:
+        return Intensity::UShort;
+    case PlyScalarType::Float32:
+        return Intensity::Float;
+    default:
+        return std::nullopt;
+    }
 }
 
 // The layout of ../shared/data, most scanners, CloudCompare, PDAL (double positions, ushort
@@ -771,13 +813,7 @@ bool PlyReader::intensityOnFastPath() const {
 // positions, optionally float or double normals, uchar, ushort or float colours and a ushort or
 // float intensity.
 bool PlyReader::fastLayout() const {
-    return fastPositions() &&
-           (!m_fields.hasNormals() || hasType(m_fields.normal, PlyScalarType::Float32) ||
-            hasType(m_fields.normal, PlyScalarType::Float64)) &&
-           (!m_fields.hasColors() || hasType(m_fields.color, PlyScalarType::UInt8) ||
-            hasType(m_fields.color, PlyScalarType::UInt16) ||
-            hasType(m_fields.color, PlyScalarType::Float32)) &&
-           intensityOnFastPath();
+    return fastPositions() && fastNormals() && fastColors() && fastIntensity();
 }
 
 FloatRecordLayout PlyReader::floatLayout() const {
@@ -793,21 +829,12 @@ FloatRecordLayout PlyReader::floatLayout() const {
             layout.color[axis] = m_propertyOffsets[m_fields.color[axis]];
         }
     }
-    if (m_fields.hasNormals()) {
-        layout.normalType = hasType(m_fields.normal, PlyScalarType::Float32)
-                                ? FloatRecordLayout::Normals::Float
-                                : FloatRecordLayout::Normals::Double;
-    }
-    if (m_fields.hasColors()) {
-        layout.colorType =
-            hasType(m_fields.color, PlyScalarType::UInt8)    ? FloatRecordLayout::Color::UChar
-            : hasType(m_fields.color, PlyScalarType::UInt16) ? FloatRecordLayout::Color::UShort
-                                                             : FloatRecordLayout::Color::Float;
-    }
+    // The bounds pre-pass takes this layout for its positions alone, whatever the other types;
+    // the conversion loops only when fastLayout().
+    layout.normalType = fastNormals().value_or(FloatRecordLayout::Normals::None);
+    layout.colorType = fastColors().value_or(FloatRecordLayout::Color::None);
+    layout.intensityType = fastIntensity().value_or(FloatRecordLayout::Intensity::None);
     if (m_fields.hasIntensity()) {
-        layout.intensityType = vertex().properties[m_fields.intensity].type == PlyScalarType::UInt16
-                                   ? FloatRecordLayout::Intensity::UShort
-                                   : FloatRecordLayout::Intensity::Float;
         layout.intensity = m_propertyOffsets[m_fields.intensity];
     }
     return layout;

@@ -44,19 +44,6 @@ double loadPlyScalar(const std::uint8_t* bytes, PlyScalarType type, bool swapByt
     return 0.0;
 }
 
-std::uint8_t plyColorChannel(double value, PlyScalarType type) {
-    double scaled = value;
-    if (type == PlyScalarType::Float32 || type == PlyScalarType::Float64) {
-        scaled = value * 255.0;
-    } else if (type == PlyScalarType::UInt16) {
-        scaled = value / 257.0;
-    }
-    if (!(scaled > 0.0)) {
-        return 0;
-    }
-    return scaled >= 255.0 ? 255 : static_cast<std::uint8_t>(scaled + 0.5);
-}
-
 PlyBodyCursor::PlyBodyCursor(FileStream& stream, std::uint64_t start)
     : m_stream(stream), m_buffer(kCursorBufferBytes), m_bufferOffset(start) {
     m_stream.seek(start);

@@ -17,8 +17,19 @@ double loadPlyScalar(const std::uint8_t* bytes, PlyScalarType type, bool swapByt
 
 // 8-bit colour channel from a value of any PLY type: uchar as is, ushort scaled (65535 ->
 // 255), float/double as 0..1 fractions, other integer types as 0..255 values. Clamped and
-// rounded; NaN gives 0.
-std::uint8_t plyColorChannel(double value, PlyScalarType type);
+// rounded; NaN gives 0. Inline: the fast PLY loops call it per channel for float colours.
+inline std::uint8_t plyColorChannel(double value, PlyScalarType type) {
+    double scaled = value;
+    if (type == PlyScalarType::Float32 || type == PlyScalarType::Float64) {
+        scaled = value * 255.0;
+    } else if (type == PlyScalarType::UInt16) {
+        scaled = value / 257.0;
+    }
+    if (!(scaled > 0.0)) {
+        return 0;
+    }
+    return scaled >= 255.0 ? 255 : static_cast<std::uint8_t>(scaled + 0.5);
+}
 
 // 16-bit intensity, clamped and rounded; NaN gives 0. Inline: the fast PLY loops call it per
 // point for a float intensity.
