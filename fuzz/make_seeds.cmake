@@ -1,4 +1,5 @@
-# The .oms and .omh fuzz seeds: bunny.ply sorted and built (depth 4, so the seeds stay small).
+# The .oms and .omh fuzz seeds: bunny.ply sorted and built (depth 4, so the seeds stay small),
+# the .omh in format versions 3 and 2.
 file(MAKE_DIRECTORY ${OUT})
 if(NOT EXISTS ${SOURCE})
   message(STATUS "no ${SOURCE}: the .oms and .omh fuzz targets will skip")
@@ -7,6 +8,10 @@ endif()
 execute_process(COMMAND ${CLI} sort ${SOURCE} ${OUT}/bunny.oms RESULT_VARIABLE sorted)
 execute_process(COMMAND ${CLI} build ${SOURCE} --depth 4 --save ${OUT}/bunny.omh
                 RESULT_VARIABLE built OUTPUT_QUIET)
-if(NOT sorted EQUAL 0 OR NOT built EQUAL 0)
-  message(FATAL_ERROR "omicron-cli could not make the fuzz seeds (${sorted}, ${built})")
+# A version 2 file too (splat attributes in every record): the reader still loads those.
+execute_process(COMMAND ${CLI} build ${SOURCE} --depth 4 --save ${OUT}/bunny-v2.omh
+                        --save-version 2
+                RESULT_VARIABLE builtV2 OUTPUT_QUIET)
+if(NOT sorted EQUAL 0 OR NOT built EQUAL 0 OR NOT builtV2 EQUAL 0)
+  message(FATAL_ERROR "omicron-cli could not make the fuzz seeds (${sorted}, ${built}, ${builtV2})")
 endif()

@@ -49,6 +49,8 @@ if [ -x build/release/bin/omicron-cli ] && [ -f "$shared/bunny.ply" ]; then
   build/release/bin/omicron-cli sort "$shared/bunny.ply" "$work/corpus-oms/bunny.oms" >/dev/null
   build/release/bin/omicron-cli build "$shared/bunny.ply" --depth 4 \
     --save "$work/corpus-omh/bunny.omh" >/dev/null
+  build/release/bin/omicron-cli build "$shared/bunny.ply" --depth 4 \
+    --save "$work/corpus-omh/bunny-v2.omh" --save-version 2 >/dev/null
 fi
 
 run() {

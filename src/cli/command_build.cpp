@@ -28,11 +28,15 @@ struct SavedFile {
     std::uint64_t bytes = 0;
 };
 
-// Test hook, not a user option: with OMICRON_TEST_PAUSE_SAVE_AFTER_LEVEL=N in the
-// environment, a save stops for a minute after level N's points went to the temporary file,
+// --save-version, and a test hook (not a user option): with OMICRON_TEST_PAUSE_SAVE_AFTER_LEVEL=N
+// in the environment, a save stops for a minute after level N's points went to the temporary file,
 // so a test can kill the process half-way and check that the previous file survives.
-OmhWriteOptions saveOptions() {
+OmhWriteOptions saveOptions(const ParsedArgs& parsed) {
     OmhWriteOptions options;
+    if (const auto version = parsed.value("save-version")) {
+        options.formatVersion =
+            static_cast<std::uint32_t>(parseInteger(*version, "save-version", 2, omh::kVersion));
+    }
     if (const char* pauseLevel = std::getenv("OMICRON_TEST_PAUSE_SAVE_AFTER_LEVEL")) {
         const int level = std::atoi(pauseLevel);
         options.afterLevel = [level](int written) {
@@ -146,7 +150,8 @@ void printText(const PipelineResult& run, const BuildOptions& options, const Sav
 
 int runBuild(const std::vector<std::string>& args) {
     const ParsedArgs parsed = parseArgs(
-        args, withOptions(withOptions(kBuildOptionSpecs, {{"json", false}, {"save", true}}),
+        args, withOptions(withOptions(kBuildOptionSpecs,
+                                      {{"json", false}, {"save", true}, {"save-version", true}}),
                           kMemoryOptionSpecs));
     if (parsed.help) {
         printCommandHelp(buildCommand());
@@ -162,6 +167,10 @@ int runBuild(const std::vector<std::string>& args) {
                                     static_cast<std::size_t>(build.threads));
 
     const std::string& path = parsed.positionals[0];
+    if (parsed.value("save-version") && !parsed.value("save")) {
+        throw UsageError("--save-version needs --save");
+    }
+    const OmhWriteOptions writeOptions = saveOptions(parsed); // a bad version before the build
     const MemoryOptions memory = memoryOptions(parsed, parsed.value("save").value_or(""));
     BuildPipeline pipeline;
     const PipelineResult run = runInterruptibly(pipeline, path,
@@ -170,7 +179,7 @@ int runBuild(const std::vector<std::string>& args) {
                                                  /*preview=*/false});
     SavedFile saved;
     if (const auto savePath = parsed.value("save")) { // the finished hierarchy, pipeline 3's input
-        writeOmh(*savePath, *pipeline.hierarchy(), omhBuildInfo(options, run.stats), saveOptions());
+        writeOmh(*savePath, *pipeline.hierarchy(), omhBuildInfo(options, run.stats), writeOptions);
         saved = {*savePath, std::filesystem::file_size(*savePath)};
     }
     if (parsed.flag("json")) {
@@ -191,7 +200,7 @@ const Command& buildCommand() {
         "build", "build the OMiCroN hierarchy of a cloud and print its statistics",
         "build IN [--depth 7] [--ratio 0.2] [--worklist N] [--collapse off|lossless|paper]\n"
         "                   [--threads T] [--chunks K] [--store exact|packed] [--save OUT.omh]\n"
-        "                   [--memory-budget SIZE] [--temp-dir DIR] [--json]",
+        "                   [--save-version 2|3] [--memory-budget SIZE] [--temp-dir DIR] [--json]",
         "Builds the octree bottom-up with oblique hierarchy cuts while the input streams in:\n"
         "an unsorted cloud (PLY, LAS, LAZ, XYZ) goes through the incremental Morton sorter first\n"
         "(pipeline 1), a sorted stream (.oms) feeds the builder directly (pipeline 2).\n"
@@ -211,6 +220,10 @@ const Command& buildCommand() {
         "  --save OUT.omh     save the finished hierarchy as a .omh file (written to a\n"
         "                     temporary file and renamed: an interrupted save leaves OUT as\n"
         "                     it was); 'info OUT.omh' prints the same per-level counts\n"
+        "  --save-version V   the .omh format version: 3 (default: splat attributes estimated\n"
+        "                     again when drawn, stored only for nodes of fewer than 8 points)\n"
+        "                     or 2 (stored for every point, 6 bytes more a point without\n"
+        "                     normals, 2 with; for omicron builds that read only version 2)\n"
         "  --memory-budget SIZE\n"
         "                     what the sort may keep resident, e.g. 512M or 4G (default: half\n"
         "                     of physical memory); a bigger sort runs on disk and its runs are\n"

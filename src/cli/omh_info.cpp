@@ -30,6 +30,18 @@ void writeVector(JsonWriter& json, const glm::dvec3& v) {
     json.beginArray().value(v.x).value(v.y).value(v.z).endArray();
 }
 
+// Points whose splat attributes the file stores: all before version 3, then the sparse nodes'.
+std::uint64_t storedSplatPoints(const omh::Header& h) {
+    if (h.splatsInRecords()) {
+        return h.totalPoints;
+    }
+    std::uint64_t points = 0;
+    for (const omh::LevelEntry& level : h.levels) {
+        points += level.sparsePoints;
+    }
+    return points;
+}
+
 void printJson(const omh::Header& h, bool verified) {
     JsonWriter json;
     json.beginObject();
@@ -65,6 +77,7 @@ void printJson(const omh::Header& h, bool verified) {
     writeLevelsJson(json, h.levels);
     json.key("nodes").value(h.totalNodes);
     json.key("points_stored").value(h.totalPoints);
+    json.key("splat_attributes_stored").value(storedSplatPoints(h));
     json.key("verified").value(verified);
     json.endObject();
     std::printf("%s\n", json.text().c_str());
@@ -88,6 +101,11 @@ void printText(const omh::Header& h, bool verified) {
                 static_cast<unsigned long long>(h.totalPoints));
     std::printf("attributes:  %s%s\n", attributes.empty() ? "none" : attributes.c_str(),
                 h.estimatedNormals ? " (+ estimated normals)" : "");
+    std::printf("splats:      stored for %llu points%s\n",
+                static_cast<unsigned long long>(storedSplatPoints(h)),
+                h.splatsInRecords() ? " (every record)"
+                                    : " (of nodes under 8 points; the others are estimated "
+                                      "when drawn)");
     std::string uniform;
     for (const std::string& name : uniformColumnNames(h)) {
         uniform.append(uniform.empty() ? "" : ", ").append(name);

@@ -74,6 +74,42 @@ TEST(CliOmh, VerifyExitsOneOnADamagedSectionAndNamesIt) {
     EXPECT_NE(verify.err.find("point records of level 5"), std::string::npos) << verify.err;
 }
 
+TEST(CliOmh, SaveVersionTwoStoresEverySplatAndBothVersionsDescribeTheSameLevels) {
+    OMICRON_REQUIRE_SHARED_FILE(input, "bunny.ply");
+    test::TempDir dir;
+    const std::string v3 = dir.file("v3.omh"), v2 = dir.file("v2.omh");
+    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"build", input, "--depth", "4", "--save", v3}).exitCode,
+              0);
+    const auto build = runProcess(
+        OMICRON_CLI_PATH, {"build", input, "--depth", "4", "--save", v2, "--save-version", "2"});
+    ASSERT_EQ(build.exitCode, 0) << build.err;
+    const auto infoV3 = runProcess(OMICRON_CLI_PATH, {"info", v3, "--json", "--verify"});
+    const auto infoV2 = runProcess(OMICRON_CLI_PATH, {"info", v2, "--json", "--verify"});
+    ASSERT_EQ(infoV3.exitCode, 0) << infoV3.err;
+    ASSERT_EQ(infoV2.exitCode, 0) << infoV2.err;
+    EXPECT_NE(infoV3.out.find("\"version\":3"), std::string::npos) << infoV3.out;
+    EXPECT_NE(infoV2.out.find("\"version\":2"), std::string::npos) << infoV2.out;
+    EXPECT_EQ(levelsArray(infoV2.out), levelsArray(infoV3.out));
+    const std::regex stored(R"re("points_stored":(\d+),"splat_attributes_stored":(\d+))re");
+    std::smatch a, b;
+    ASSERT_TRUE(std::regex_search(infoV2.out, a, stored)) << infoV2.out;
+    ASSERT_TRUE(std::regex_search(infoV3.out, b, stored)) << infoV3.out;
+    EXPECT_EQ(a[1], a[2]) << "version 2 stores every point's attributes";
+    EXPECT_LT(std::stoull(b[2]), std::stoull(b[1])) << "version 3 only the sparse nodes'";
+    // Bunny has normals: a version 2 record is 2 bytes longer for each estimated point.
+    EXPECT_EQ(std::filesystem::file_size(v2) - std::filesystem::file_size(v3),
+              2 * (std::stoull(b[1]) - std::stoull(b[2])) -
+                  5 * 8) // 5 level entries, 8 bytes shorter
+        << infoV2.out << infoV3.out;
+    for (const char* bad : {"1", "4", "three"}) {
+        const auto refused = runProcess(
+            OMICRON_CLI_PATH, {"build", input, "--save", dir.file("x.omh"), "--save-version", bad});
+        EXPECT_EQ(refused.exitCode, 2) << bad;
+        EXPECT_NE(refused.err.find("--save-version"), std::string::npos) << refused.err;
+        EXPECT_FALSE(std::filesystem::exists(dir.file("x.omh")));
+    }
+}
+
 TEST(CliOmh, SaveIntoAMissingFolderFailsNamingTheFile) {
     OMICRON_REQUIRE_SHARED_FILE(input, "bunny.ply");
     test::TempDir dir;

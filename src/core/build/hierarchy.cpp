@@ -10,8 +10,10 @@ namespace omicron {
 Hierarchy::Hierarchy(std::shared_ptr<const SortedCloud> cloud, int maxLevel,
                      SplatSource splatSource)
     : m_cloud(std::move(cloud)), m_maxLevel(maxLevel), m_insertions(m_cloud->capacity()),
-      m_storedSplats(splatSource == SplatSource::Stored ? std::make_unique<StoredSplats>(*m_cloud)
-                                                        : nullptr) {
+      m_storedSplats(splatSource != SplatSource::Estimated
+                         ? std::make_unique<StoredSplats>(*m_cloud)
+                         : nullptr),
+      m_storedForSparseNodesOnly(splatSource == SplatSource::StoredForSparseNodes) {
     assert(maxLevel >= 0 && maxLevel <= morton::kMaxLevel);
     m_levels.reserve(static_cast<std::size_t>(maxLevel) + 1);
     for (int level = 0; level <= maxLevel; ++level) {
@@ -45,7 +47,8 @@ std::optional<std::size_t> Hierarchy::findNode(morton::Code code, std::size_t co
 }
 
 void Hierarchy::nodeSplats(const OctreeNode& node, NodeSplats& out, SplatScratch& scratch) const {
-    if (!m_storedSplats) {
+    if (!m_storedSplats ||
+        (m_storedForSparseNodesOnly && node.pointCount >= kMinPointsPerSplatEstimate)) {
         // Finding the region costs two searches of the cloud: only for the nodes that use it.
         const SparseSplatRegion region = node.pointCount < kMinPointsPerSplatEstimate
                                              ? sparseSplatRegion(node)

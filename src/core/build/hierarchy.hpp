@@ -59,6 +59,9 @@ struct CutInsertion {
 enum class SplatSource {
     Estimated, // a build: estimated per node when asked for (splat_estimator.hpp)
     Stored,    // a loaded .omh file: one stored record per held point (stored_splats.hpp)
+    // A loaded .omh file of version 3: stored for the points of nodes too sparse for an
+    // estimate of their own (which borrows points of other nodes), estimated for the others.
+    StoredForSparseNodes,
 };
 
 class Hierarchy {
@@ -150,7 +153,7 @@ public:
     const std::uint32_t* adoptSamples(SampleBuffer&& samples) {
         return m_samples.adopt(std::move(samples));
     }
-    StoredSplats& mutableStoredSplats() { return *m_storedSplats; } // SplatSource::Stored only
+    StoredSplats& mutableStoredSplats() { return *m_storedSplats; } // SplatSource::Stored*
     // Set once, before the hierarchy is shared. The hierarchy owns it and destroys it first,
     // so its loading threads stop before the cloud and splats they write go away.
     void setResidency(std::unique_ptr<NodeResidency> residency) {
@@ -194,7 +197,8 @@ private:
     std::vector<std::unique_ptr<Level>> m_levels;
     InsertionLog m_insertions; // every leaf covers at least one point: capacity = the cloud's
     SampleStore m_samples;
-    std::unique_ptr<StoredSplats> m_storedSplats; // SplatSource::Stored only
+    std::unique_ptr<StoredSplats> m_storedSplats; // SplatSource::Stored*
+    bool m_storedForSparseNodesOnly = false;
     std::atomic<morton::Code> m_cutDelimiter{0};
     std::atomic<std::uint64_t> m_epoch{0};
     std::atomic<bool> m_complete{false};

@@ -31,7 +31,7 @@ std::array<std::uint8_t, kHeaderBytes> encodeHeader(const Header& h) {
     std::array<std::uint8_t, kHeaderBytes> bytes{}; // reserved fields stay zero
     std::uint8_t* at = bytes.data();
     std::memcpy(at + f::kMagic, kMagic.data(), kMagic.size());
-    storeRaw(at + f::kVersion, kVersion);
+    storeRaw(at + f::kVersion, h.version);
     storeRaw(at + f::kEndianness, kEndiannessMarker);
     storeRaw(at + f::kTotalNodes, h.totalNodes);
     storeRaw(at + f::kTotalPoints, h.totalPoints);
@@ -61,10 +61,12 @@ std::array<std::uint8_t, kHeaderBytes> encodeHeader(const Header& h) {
     return bytes;
 }
 
-std::vector<std::uint8_t> encodeLevelTable(const std::vector<LevelEntry>& levels) {
-    std::vector<std::uint8_t> bytes(levels.size() * kLevelEntryBytes + 8);
+std::vector<std::uint8_t> encodeLevelTable(const std::vector<LevelEntry>& levels,
+                                           std::uint32_t version) {
+    const std::size_t stride = levelEntryBytes(version);
+    std::vector<std::uint8_t> bytes(levels.size() * stride + 8);
     for (std::size_t l = 0; l < levels.size(); ++l) {
-        std::uint8_t* at = bytes.data() + l * kLevelEntryBytes;
+        std::uint8_t* at = bytes.data() + l * stride;
         const LevelEntry& e = levels[l];
         storeRaw(at + level::kNodes, e.nodes);
         storeRaw(at + level::kLeaves, e.leaves);
@@ -73,8 +75,11 @@ std::vector<std::uint8_t> encodeLevelTable(const std::vector<LevelEntry>& levels
         storeRaw(at + level::kPayloadOffset, e.payloadOffset);
         storeRaw(at + level::kNodeChecksum, e.nodeChecksum);
         storeRaw(at + level::kPayloadChecksum, e.payloadChecksum);
+        if (stride > level::kSparsePoints) {
+            storeRaw(at + level::kSparsePoints, e.sparsePoints);
+        }
     }
-    const std::size_t entryBytes = levels.size() * kLevelEntryBytes;
+    const std::size_t entryBytes = levels.size() * stride;
     storeRaw(bytes.data() + entryBytes, smallChecksum(bytes.data(), entryBytes));
     return bytes;
 }

@@ -5,13 +5,14 @@
 //   header       256 bytes  magic "OMICRONH", version, endianness marker, totals, build
 //                           parameters (depth, ratio, collapse), attribute layout, cube and
 //                           source offset; XXH64 of the 248 bytes before it
-//   level table  L x 56 + 8 per level: nodes, leaves, points, node-table and payload offsets,
-//                           XXH3-64 of the level's node records and of its point records;
-//                           then XXH64 of the entries
+//   level table  L x 64 + 8 per level: nodes, leaves, points, node-table and payload offsets,
+//                           XXH3-64 of the level's node records and of its payload, the
+//                           points of its sparse nodes; then XXH64 of the entries
 //   node table   32 bytes per node, breadth first: level 0, then level 1 ... each level in
 //                           Morton order (code, first point, point count, splat scale, child
 //                           mask, flags)
-//   payload      R bytes per held point, grouped by node in node-table order
+//   payload      per level: R bytes per held point, grouped by node in node-table order;
+//                           then the splat attributes of the points of its sparse nodes
 //   footer       32 bytes   magic "OMHEND\0\0", total nodes, total points, XXH64 of them
 //
 // Each level has its own checksums so a progressive reader verifies a level before it
@@ -19,6 +20,7 @@
 #pragma once
 
 #include "build/build_options.hpp"
+#include "build/splat_estimator.hpp"
 #include "formats/oms_format.hpp"
 #include "points/cube_transform.hpp"
 #include "points/point_batch.hpp"
@@ -35,16 +37,27 @@ namespace omicron::omh {
 inline constexpr std::array<char, 8> kMagic{'O', 'M', 'I', 'C', 'R', 'O', 'N', 'H'};
 inline constexpr std::array<char, 8> kFooterMagic{'O', 'M', 'H', 'E', 'N', 'D', '\0', '\0'};
 // Version 2 added uniform columns (header bytes 130-247, zero in version 1, which still loads).
-inline constexpr std::uint32_t kVersion = 2;
+// Version 3 took the splat attributes out of the records: a reader estimates them from the
+// node's points as a build does (the same bytes), except for the points of sparse nodes
+// (fewer than kMinPointsPerSplatEstimate points, whose estimate borrows points of other nodes),
+// stored after their level's records; the level entry gained their count (56 -> 64 bytes).
+inline constexpr std::uint32_t kVersion = 3;
 inline constexpr std::uint32_t kOldestVersion = 1;
+inline constexpr std::uint32_t kFirstVersionWithoutSplatRecords = 3;
 inline constexpr std::uint32_t kEndiannessMarker = oms::kEndiannessMarker;
 inline constexpr std::uint8_t kKnownAttributeBits = oms::kKnownAttributeBits;
-// Splat bit 0: each record carries the estimated normal (the cloud has no normals of its own).
+// Splat bit 0: a point's splat attributes include the estimated normal (the cloud has no
+// normals of its own).
 inline constexpr std::uint8_t kSplatEstimatedNormal = 0x01;
 inline constexpr std::uint8_t kKnownNodeFlags = 0x03; // NodeFlag::Leaf | NodeFlag::Collapsed
 
 inline constexpr std::size_t kHeaderBytes = 256;
-inline constexpr std::size_t kLevelEntryBytes = 56;
+inline constexpr std::size_t kLevelEntryBytesBeforeV3 = 56;
+inline constexpr std::size_t kLevelEntryBytes = 64;
+constexpr std::size_t levelEntryBytes(std::uint32_t version) {
+    return version >= kFirstVersionWithoutSplatRecords ? kLevelEntryBytes
+                                                       : kLevelEntryBytesBeforeV3;
+}
 inline constexpr std::size_t kNodeRecordBytes = 32;
 inline constexpr std::size_t kFooterBytes = 32;
 
@@ -91,7 +104,8 @@ inline constexpr std::size_t kPoints = 16;           // u64, records held by the
 inline constexpr std::size_t kNodeTableOffset = 24;  // u64, absolute byte offset
 inline constexpr std::size_t kPayloadOffset = 32;    // u64, absolute byte offset
 inline constexpr std::size_t kNodeChecksum = 40;     // u64, XXH3-64 of the level's node records
-inline constexpr std::size_t kPayloadChecksum = 48;  // u64, XXH3-64 of the level's records
+inline constexpr std::size_t kPayloadChecksum = 48;  // u64, XXH3-64 of the level's payload
+inline constexpr std::size_t kSparsePoints = 56;     // u64, version 3: points of sparse nodes
 } // namespace level
 
 namespace node {
@@ -127,31 +141,53 @@ constexpr AttributeSet recordAttributes(AttributeSet attributes, std::uint8_t un
     return AttributeSet::fromBits(bits, extraBytes);
 }
 
+// A point's splat attributes: the radius (encodeRadius) and, when the splat bit says so, the
+// octahedral estimated normal.
+constexpr std::size_t splatBytes(bool estimatedNormal) {
+    return sizeof(std::uint16_t) + (estimatedNormal ? sizeof(std::uint32_t) : 0);
+}
+
 // A point record: the .oms record (position, optional normal, colour, intensity, LAS column;
-// not the uniform columns), then the splat radius (encodeRadius) and, when the splat bit says
-// so, the octahedral estimated normal.
+// not the uniform columns), then before version 3 the point's splat attributes.
 struct RecordLayout {
     oms::RecordLayout point;
     AttributeSet attributes; // what the record carries of the cloud's attributes
+    bool splats = false;     // the record ends with the splat attributes (before version 3)
+    bool estimatedNormal = false; // a point's splat attributes include the estimated normal
     std::size_t radiusOffset = 0;
-    std::size_t estimatedNormalOffset = 0;
+    std::size_t estimatedNormalOffset = 0; // 0: none in the record
     std::size_t bytes = 0;
 
     static constexpr RecordLayout of(AttributeSet attributes, bool estimatedNormal,
-                                     std::uint8_t uniformColumns = 0) {
+                                     std::uint8_t uniformColumns, std::uint32_t version) {
         RecordLayout layout;
         layout.attributes = recordAttributes(attributes, uniformColumns);
         layout.point = oms::RecordLayout::of(layout.attributes);
-        layout.radiusOffset = layout.point.bytes;
-        std::size_t at = layout.radiusOffset + sizeof(std::uint16_t);
-        if (estimatedNormal) {
-            layout.estimatedNormalOffset = at;
-            at += sizeof(std::uint32_t);
+        layout.bytes = layout.point.bytes;
+        layout.estimatedNormal = estimatedNormal;
+        layout.splats = version < kFirstVersionWithoutSplatRecords;
+        if (layout.splats) {
+            layout.radiusOffset = layout.point.bytes;
+            if (estimatedNormal) {
+                layout.estimatedNormalOffset = layout.radiusOffset + sizeof(std::uint16_t);
+            }
+            layout.bytes += splatBytes(estimatedNormal);
         }
-        layout.bytes = at;
         return layout;
     }
 };
+
+// A node whose splat attributes a version 3 file stores (after its level's records): one too
+// sparse for an estimate from its own points. kMinPointsPerSplatEstimate's value is part of
+// the format.
+constexpr bool storesSplats(std::uint64_t nodePoints) {
+    return nodePoints < kMinPointsPerSplatEstimate;
+}
+// Whether a file of `layout` stores a node's splat attributes: every node's in its records
+// before version 3, a sparse node's after its level's records from version 3 on.
+constexpr bool storesSplats(const RecordLayout& layout, std::uint64_t nodePoints) {
+    return layout.splats || storesSplats(nodePoints);
+}
 
 // What determines the stored hierarchy besides its input, and the build's counts worth keeping.
 struct BuildInfo {
@@ -171,6 +207,7 @@ struct LevelEntry {
     std::uint64_t payloadOffset = 0;
     std::uint64_t nodeChecksum = 0;
     std::uint64_t payloadChecksum = 0;
+    std::uint64_t sparsePoints = 0; // version 3: points of the nodes that storesSplats()
 };
 
 // Everything the header and level table say.
@@ -192,12 +229,29 @@ struct Header {
     std::uint64_t totalPoints = 0;
     std::vector<LevelEntry> levels; // index = level, 0..maxLevel
 
+    bool splatsInRecords() const { return version < kFirstVersionWithoutSplatRecords; }
+    // Bytes of one point's stored splat attributes (in its record, or after its level's).
+    std::size_t splatBytes() const { return omh::splatBytes(estimatedNormals); }
+    // A level's payload: its records, then (version 3) its sparse nodes' splat attributes.
+    std::uint64_t payloadBytes(const LevelEntry& level) const {
+        return level.points * recordBytes + level.sparsePoints * splatBytes();
+    }
+    // Where the splat attributes of a level's sparse nodes start.
+    std::uint64_t sparseSplatsOffset(const LevelEntry& level) const {
+        return level.payloadOffset + level.points * recordBytes;
+    }
     std::uint64_t levelTableOffset() const { return kHeaderBytes; }
     std::uint64_t nodeTableOffset() const {
-        return kHeaderBytes + levels.size() * kLevelEntryBytes + 8;
+        return kHeaderBytes + levels.size() * levelEntryBytes(version) + 8;
     }
     std::uint64_t payloadOffset() const { return nodeTableOffset() + totalNodes * kNodeRecordBytes; }
-    std::uint64_t footerOffset() const { return payloadOffset() + totalPoints * recordBytes; }
+    std::uint64_t footerOffset() const {
+        std::uint64_t end = payloadOffset();
+        for (const LevelEntry& level : levels) {
+            end += payloadBytes(level);
+        }
+        return end;
+    }
 };
 
 std::uint8_t encodeCollapse(LeafCollapse collapse);
@@ -206,8 +260,9 @@ std::uint8_t encodeCollapse(LeafCollapse collapse);
 std::uint64_t smallChecksum(const void* bytes, std::size_t count);
 
 std::array<std::uint8_t, kHeaderBytes> encodeHeader(const Header& header);
-// The level entries and their checksum, levels.size() * kLevelEntryBytes + 8 bytes.
-std::vector<std::uint8_t> encodeLevelTable(const std::vector<LevelEntry>& levels);
+// The level entries and their checksum, levels.size() * levelEntryBytes(version) + 8 bytes.
+std::vector<std::uint8_t> encodeLevelTable(const std::vector<LevelEntry>& levels,
+                                           std::uint32_t version);
 std::array<std::uint8_t, kFooterBytes> encodeFooter(std::uint64_t totalNodes,
                                                     std::uint64_t totalPoints);
 

@@ -3,6 +3,7 @@
 #include "formats/omh_reader.hpp"
 #include "formats/omh_record_decoder.hpp"
 #include "io/input_error.hpp"
+#include "io/raw_bytes.hpp"
 
 #include <algorithm>
 
@@ -198,6 +199,9 @@ void OmhPager::load(int level, std::uint32_t index) {
             throw m_decoder.misplaced(
                 level, begin + bad - m_levelFirst[static_cast<std::size_t>(level)], node.code);
         }
+        if (!m_header.splatsInRecords() && omh::storesSplats(count)) {
+            loadSparseSplats(level, index, node);
+        }
     } catch (const InputError& error) {
         m_pages.release(begin, begin + count);
         fail(id, error.what());
@@ -213,6 +217,37 @@ void OmhPager::load(int level, std::uint32_t index) {
     }
     m_state[id].store(Resident, std::memory_order_release);
     m_pending.fetch_sub(1, std::memory_order_relaxed);
+}
+
+void OmhPager::loadSparseSplats(int level, std::uint32_t index, const OctreeNode& node) {
+    const auto l = static_cast<std::size_t>(level);
+    const omh::LevelEntry& entry = m_header.levels[l];
+    if (m_sparseBefore.empty()) {
+        m_sparseBefore.resize(m_header.levels.size());
+    }
+    std::vector<std::uint64_t>& before = m_sparseBefore[l];
+    if (before.empty()) { // the level's nodes are all published: this one was asked for
+        before.resize(entry.nodes);
+        std::uint64_t points = 0;
+        for (std::size_t i = 0; i < entry.nodes; ++i) {
+            before[i] = points;
+            const std::uint32_t count = m_hierarchy.node(level, i).pointCount;
+            points += omh::storesSplats(count) ? count : 0;
+        }
+    }
+    const std::size_t splatBytes = m_header.splatBytes();
+    const std::uint64_t offset = m_header.sparseSplatsOffset(entry) + before[index] * splatBytes;
+    m_records.resize(std::size_t{node.pointCount} * splatBytes);
+    m_stream.seek(offset);
+    m_stream.readExact(m_records.data(), m_records.size(), omhSectionAt(m_header, offset));
+    StoredSplats& splats = m_hierarchy.mutableStoredSplats();
+    for (std::uint32_t p = 0; p < node.pointCount; ++p) {
+        const std::uint8_t* at = m_records.data() + p * splatBytes;
+        splats.setEncoded(
+            node.coveredBegin + p, loadRaw<std::uint16_t>(at),
+            m_header.estimatedNormals ? loadRaw<std::uint32_t>(at + sizeof(std::uint16_t)) : 0u);
+    }
+    m_bytesRead.fetch_add(m_records.size(), std::memory_order_relaxed);
 }
 
 void OmhPager::fail(std::uint64_t id, const std::string& error) {

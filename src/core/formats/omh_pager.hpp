@@ -80,6 +80,8 @@ private:
     void publishRequests(std::uint32_t frame);
     void loaderLoop();
     void load(int level, std::uint32_t index);
+    // Version 3: reads the stored splat attributes of `node`, a sparse node of `level`.
+    void loadSparseSplats(int level, std::uint32_t index, const OctreeNode& node);
     void evict(int level, std::uint32_t index);
     void fail(std::uint64_t id, const std::string& error);
 
@@ -94,6 +96,9 @@ private:
     FileStream m_stream;                // the loader's
     OmhRecordDecoder m_decoder;         // the loader's
     std::vector<std::uint8_t> m_records; // the loader's
+    // Version 3, the loader's: per level (filled at its first load), the points of the sparse
+    // nodes before each node, where its splat attributes are among the level's.
+    std::vector<std::vector<std::uint64_t>> m_sparseBefore;
 
     std::unique_ptr<std::atomic<std::uint8_t>[]> m_state;
     std::vector<std::uint32_t> m_wantedFrame; // render thread: the last frame that asked

@@ -36,6 +36,7 @@ public:
     // Queues the records of every point `node` holds; `node` and `splats` must stay valid
     // until finish().
     void add(int level, const OctreeNode& node, const NodeSplats& splats) {
+        m_sinks[static_cast<std::size_t>(level - m_firstLevel)].addSparseSplats(node, splats);
         for (std::uint32_t p = 0; p < node.pointCount;) {
             if (m_blocks.empty() || m_blocks.back().level != level ||
                 m_blocks.back().records == m_blockRecords) {
@@ -250,7 +251,10 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
         batch.splats.resize(batch.nodes.size());
         tbb::parallel_for(std::size_t{0}, batch.nodes.size(), [&](std::size_t b) {
             const auto [level, index] = batch.nodes[b];
-            hierarchy.nodeSplats(hierarchy.node(level, index), batch.splats[b], scratch.local());
+            const OctreeNode& node = hierarchy.node(level, index);
+            if (omh::storesSplats(layout, node.pointCount)) { // else the reader estimates them
+                hierarchy.nodeSplats(node, batch.splats[b], scratch.local());
+            }
             // Over a scratch-file cloud read ahead, faults find the page cache and map pages
             // faster than the governor's thread, which may wait for a core, can drop them.
             cloud.keepWithinBudget();

@@ -85,9 +85,22 @@ std::string omhSectionAt(const omh::Header& header, std::uint64_t offset) {
             return "the point records of " + levelName(static_cast<int>(l)) + " (" +
                    range(e.payloadOffset, end) + ")";
         }
+        const std::uint64_t splatsEnd = e.payloadOffset + header.payloadBytes(e);
+        if (offset >= end && offset < splatsEnd) {
+            return "the sparse nodes' splat attributes of " + levelName(static_cast<int>(l)) +
+                   " (" + range(end, splatsEnd) + ")";
+        }
     }
     const std::uint64_t footer = header.footerOffset();
     return "the footer (" + range(footer, footer + omh::kFooterBytes) + ")";
+}
+
+std::string omhPayloadName(const omh::Header& header, const omh::LevelEntry& level) {
+    std::string name = omhSectionAt(header, level.payloadOffset);
+    if (level.sparsePoints > 0) {
+        name += " and " + omhSectionAt(header, header.sparseSplatsOffset(level));
+    }
+    return name;
 }
 
 OmhReader::OmhReader(const std::string& path) : m_stream(path) {
@@ -227,7 +240,8 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
             throw malformed(h::kReserved2, "expected a reserved zero byte");
         }
     }
-    m_layout = omh::RecordLayout::of(info.attributes, info.estimatedNormals, info.uniformColumns);
+    m_layout =
+        omh::RecordLayout::of(info.attributes, info.estimatedNormals, info.uniformColumns, version);
     info.recordBytes = loadRaw<std::uint16_t>(header.data() + h::kRecordBytes);
     if (info.recordBytes != m_layout.bytes) {
         throw malformed(h::kRecordBytes, "expected a record size of " +
@@ -264,7 +278,8 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
 
     // Level table.
     const std::size_t levelCount = static_cast<std::size_t>(maxLevel) + 1;
-    const std::uint64_t tableBytes = levelCount * omh::kLevelEntryBytes + 8;
+    const std::size_t entryStride = omh::levelEntryBytes(version);
+    const std::uint64_t tableBytes = levelCount * entryStride + 8;
     if (fileBytes < omh::kHeaderBytes + tableBytes) {
         throw error(InputErrorKind::Truncated, fileBytes,
                     "the file ends inside the level table (" +
@@ -272,7 +287,7 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     }
     std::vector<std::uint8_t> table(tableBytes);
     m_stream.readExact(table.data(), table.size(), "the level table");
-    const std::uint64_t entryBytes = levelCount * omh::kLevelEntryBytes;
+    const std::uint64_t entryBytes = levelCount * entryStride;
     const auto storedTableChecksum = loadRaw<std::uint64_t>(table.data() + entryBytes);
     const std::uint64_t tableChecksum = omh::smallChecksum(table.data(), entryBytes);
     if (storedTableChecksum != tableChecksum) {
@@ -285,7 +300,7 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     info.levels.resize(levelCount);
     std::uint64_t nodes = 0, points = 0;
     for (std::size_t l = 0; l < levelCount; ++l) {
-        const std::uint8_t* at = table.data() + l * omh::kLevelEntryBytes;
+        const std::uint8_t* at = table.data() + l * entryStride;
         omh::LevelEntry& e = info.levels[l];
         e.nodes = loadRaw<std::uint64_t>(at + omh::level::kNodes);
         e.leaves = loadRaw<std::uint64_t>(at + omh::level::kLeaves);
@@ -294,7 +309,10 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
         e.payloadOffset = loadRaw<std::uint64_t>(at + omh::level::kPayloadOffset);
         e.nodeChecksum = loadRaw<std::uint64_t>(at + omh::level::kNodeChecksum);
         e.payloadChecksum = loadRaw<std::uint64_t>(at + omh::level::kPayloadChecksum);
-        const std::uint64_t byte = omh::kHeaderBytes + l * omh::kLevelEntryBytes;
+        if (!info.splatsInRecords()) {
+            e.sparsePoints = loadRaw<std::uint64_t>(at + omh::level::kSparsePoints);
+        }
+        const std::uint64_t byte = omh::kHeaderBytes + l * entryStride;
         const auto bad = [&](const std::string& detail) {
             return error(InputErrorKind::MalformedHeader, byte,
                          "in the level table, " + levelName(static_cast<int>(l)) + ": " + detail);
@@ -302,10 +320,11 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
         const std::uint64_t cells = l * 3 < 63 ? std::uint64_t{1} << (3 * l) : UINT64_MAX;
         if ((l == 0 && e.nodes != 1) || e.nodes > cells || e.leaves > e.nodes ||
             e.points < e.nodes || e.nodes > info.totalNodes - nodes ||
-            e.points > info.totalPoints - points) {
+            e.points > info.totalPoints - points || e.sparsePoints > e.points) {
             throw bad("the counts (" + std::to_string(e.nodes) + " nodes, " +
                       std::to_string(e.leaves) + " leaves, " + std::to_string(e.points) +
-                      " points) do not fit the header's totals and the octree");
+                      " points, " + std::to_string(e.sparsePoints) +
+                      " of sparse nodes) do not fit the header's totals and the octree");
         }
         const std::uint64_t expectedNodeOffset =
             info.nodeTableOffset() + nodes * omh::kNodeRecordBytes;
@@ -338,14 +357,20 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
     for (std::size_t l = 0; l < levelCount; ++l) {
         if (info.levels[l].payloadOffset != payloadOffset) {
             throw error(InputErrorKind::MalformedHeader,
-                        omh::kHeaderBytes + l * omh::kLevelEntryBytes + omh::level::kPayloadOffset,
+                        omh::kHeaderBytes + l * entryStride + omh::level::kPayloadOffset,
                         "in the level table, " + levelName(static_cast<int>(l)) +
                             ": expected the point records at byte " +
                             std::to_string(payloadOffset));
         }
-        payloadOffset += info.levels[l].points * info.recordBytes;
+        payloadOffset += info.payloadBytes(info.levels[l]);
     }
     const std::uint64_t expectedBytes = info.footerOffset() + omh::kFooterBytes;
+    if (fileBytes < expectedBytes) { // version 3: inside a level's sparse splats or the footer
+        throw error(InputErrorKind::Truncated, fileBytes,
+                    "the file ends at byte " + std::to_string(fileBytes) + ", inside " +
+                        omhSectionAt(info, fileBytes) + "; the level table declares " +
+                        std::to_string(expectedBytes) + " bytes");
+    }
     if (fileBytes != expectedBytes) {
         throw error(InputErrorKind::CountMismatch, expectedBytes,
                     "the file should end with its footer at byte " + std::to_string(expectedBytes) +
@@ -395,8 +420,9 @@ void OmhReader::createHierarchy() {
                                            ? m_header.uniformLasRecord.data()
                                            : nullptr);
         }
-        m_hierarchy =
-            std::make_shared<Hierarchy>(m_cloud, m_header.build.maxLevel, SplatSource::Stored);
+        m_hierarchy = std::make_shared<Hierarchy>(
+            m_cloud, m_header.build.maxLevel,
+            m_header.splatsInRecords() ? SplatSource::Stored : SplatSource::StoredForSparseNodes);
         if (pagedOnDemand()) {
             m_hierarchy->setResidency(
                 std::make_unique<OmhPager>(m_header, m_cloud, *m_hierarchy, m_pagedBudget));
@@ -451,7 +477,7 @@ std::vector<OctreeNode> OmhReader::readNodes(int level, std::vector<std::uint8_t
     std::vector<OctreeNode> nodes(entry.nodes);
     std::vector<morton::Code> nextCodes;
     childMasks.assign(entry.nodes, 0);
-    std::uint64_t leaves = 0, points = 0;
+    std::uint64_t leaves = 0, points = 0, sparsePoints = 0;
     std::uint32_t nextChild = 0;
     for (std::size_t i = 0; i < entry.nodes; ++i) {
         const std::uint8_t* record = m_block.data() + i * omh::kNodeRecordBytes;
@@ -511,6 +537,7 @@ std::vector<OctreeNode> OmhReader::readNodes(int level, std::vector<std::uint8_t
         }
         leaves += node.isLeaf() ? 1 : 0;
         points += count;
+        sparsePoints += !m_header.splatsInRecords() && omh::storesSplats(count) ? count : 0;
     }
     if (leaves != entry.leaves || points != entry.points) {
         throw InputError(InputErrorKind::CountMismatch, m_header.path,
@@ -520,6 +547,14 @@ std::vector<OctreeNode> OmhReader::readNodes(int level, std::vector<std::uint8_t
                              " points, the level table declares " + std::to_string(entry.leaves) +
                              " and " + std::to_string(entry.points));
     }
+    if (sparsePoints != entry.sparsePoints) {
+        throw InputError(InputErrorKind::CountMismatch, m_header.path,
+                         InputLocation::byte(entry.nodeTableOffset),
+                         "in " + section + ": the nodes of fewer than " +
+                             std::to_string(kMinPointsPerSplatEstimate) + " points hold " +
+                             std::to_string(sparsePoints) + " points, the level table declares " +
+                             std::to_string(entry.sparsePoints));
+    }
     expectedCodes = std::move(nextCodes);
     return nodes;
 }
@@ -528,6 +563,7 @@ void OmhReader::readPoints(int level, const std::vector<OctreeNode>& nodes,
                            std::uint64_t firstPoint) {
     const omh::LevelEntry& entry = m_header.levels[static_cast<std::size_t>(level)];
     const std::string section = omhSectionAt(m_header, entry.payloadOffset);
+    const std::string payload = omhPayloadName(m_header, entry);
     const std::size_t recordBytes = m_layout.bytes;
     const std::size_t blockRecords = std::max<std::size_t>(1, kBlockBytes / recordBytes);
     const OmhRecordDecoder decoder(m_header, *m_cloud, m_hierarchy->mutableStoredSplats());
@@ -563,15 +599,56 @@ void OmhReader::readPoints(int level, const std::vector<OctreeNode>& nodes,
         }
         begin += count;
     }
+    readSparseSplats(level, nodes, checksum);
     const std::uint64_t digest = checksum.digest();
     if (digest != entry.payloadChecksum) {
-        throw InputError(
-            InputErrorKind::MalformedValue, m_header.path, InputLocation::byte(entry.payloadOffset),
-            "checksum mismatch in " + section + ": the level table stores XXH3-64 " +
-                hexText(entry.payloadChecksum) + ", the records hash to " + hexText(digest));
+        throw InputError(InputErrorKind::MalformedValue, m_header.path,
+                         InputLocation::byte(entry.payloadOffset),
+                         "checksum mismatch in " + payload + ": the level table stores XXH3-64 " +
+                             hexText(entry.payloadChecksum) + ", they hash to " + hexText(digest));
     }
     if (firstProblem) {
         throw *firstProblem;
+    }
+}
+
+void OmhReader::readSparseSplats(int level, const std::vector<OctreeNode>& nodes,
+                                 oms::PayloadChecksum& checksum) {
+    const omh::LevelEntry& entry = m_header.levels[static_cast<std::size_t>(level)];
+    if (entry.sparsePoints == 0) {
+        return;
+    }
+    const std::string section = omhSectionAt(m_header, m_header.sparseSplatsOffset(entry));
+    const std::size_t splatBytes = m_header.splatBytes();
+    const std::size_t blockPoints = kBlockBytes / splatBytes;
+    StoredSplats& splats = m_hierarchy->mutableStoredSplats();
+    auto node = nodes.begin();
+    std::uint32_t inNode = 0; // the next point of *node, a sparse node
+    const auto nextSparse = [&] {
+        while (!omh::storesSplats(node->pointCount)) {
+            ++node; // readNodes counted entry.sparsePoints points in such nodes
+        }
+    };
+    nextSparse();
+    for (std::uint64_t begin = 0; begin < entry.sparsePoints;) {
+        const std::size_t count = static_cast<std::size_t>(
+            std::min<std::uint64_t>(blockPoints, entry.sparsePoints - begin));
+        m_block.resize(count * splatBytes);
+        m_stream.readExact(m_block.data(), m_block.size(), section);
+        checksum.update(m_block.data(), m_block.size());
+        for (std::size_t p = 0; p < count; ++p) {
+            const std::uint8_t* at = m_block.data() + p * splatBytes;
+            splats.setEncoded(node->coveredBegin + inNode, loadRaw<std::uint16_t>(at),
+                              m_header.estimatedNormals
+                                  ? loadRaw<std::uint32_t>(at + sizeof(std::uint16_t))
+                                  : 0u);
+            if (++inNode == node->pointCount && begin + p + 1 < entry.sparsePoints) {
+                ++node;
+                inNode = 0;
+                nextSparse();
+            }
+        }
+        begin += count;
     }
 }
 
@@ -621,8 +698,8 @@ void OmhReader::load(const LevelCallback& onLevel, const std::atomic<bool>* canc
 }
 
 void OmhReader::verify() {
-    const auto check = [&](std::uint64_t offset, std::uint64_t bytes, std::uint64_t expected) {
-        const std::string section = omhSectionAt(m_header, offset);
+    const auto check = [&](std::uint64_t offset, std::uint64_t bytes, std::uint64_t expected,
+                           const std::string& section) {
         oms::PayloadChecksum checksum;
         m_stream.seek(offset);
         for (std::uint64_t done = 0; done < bytes;) {
@@ -645,10 +722,12 @@ void OmhReader::verify() {
     };
     // Header, level table and footer were verified at open.
     for (const omh::LevelEntry& e : m_header.levels) {
-        check(e.nodeTableOffset, e.nodes * omh::kNodeRecordBytes, e.nodeChecksum);
+        check(e.nodeTableOffset, e.nodes * omh::kNodeRecordBytes, e.nodeChecksum,
+              omhSectionAt(m_header, e.nodeTableOffset));
     }
     for (const omh::LevelEntry& e : m_header.levels) {
-        check(e.payloadOffset, e.points * m_header.recordBytes, e.payloadChecksum);
+        check(e.payloadOffset, m_header.payloadBytes(e), e.payloadChecksum,
+              omhPayloadName(m_header, e));
     }
 }
 

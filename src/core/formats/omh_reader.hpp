@@ -73,6 +73,9 @@ private:
                                       std::vector<morton::Code>& expectedCodes,
                                       std::uint64_t firstPoint);
     void readPoints(int level, const std::vector<OctreeNode>& nodes, std::uint64_t firstPoint);
+    // Version 3: the splat attributes of the level's sparse nodes, after its records.
+    void readSparseSplats(int level, const std::vector<OctreeNode>& nodes,
+                          oms::PayloadChecksum& checksum);
 
     FileStream m_stream;
     omh::Header m_header;
@@ -87,5 +90,8 @@ private:
 
 // "the node table of level 3 (bytes 1024-2047)" etc.: the section holding byte `offset`.
 std::string omhSectionAt(const omh::Header& header, std::uint64_t offset);
+// The section of a level's payload checksum: its point records, and (version 3) its sparse
+// nodes' splat attributes when it has any.
+std::string omhPayloadName(const omh::Header& header, const omh::LevelEntry& level);
 
 } // namespace omicron

@@ -12,7 +12,7 @@ namespace omicron {
 OmhRecordDecoder::OmhRecordDecoder(const omh::Header& header, SortedCloud& cloud,
                                    StoredSplats& splats)
     : m_header(header), m_layout(omh::RecordLayout::of(header.attributes, header.estimatedNormals,
-                                                       header.uniformColumns)),
+                                                       header.uniformColumns, header.version)),
       // Without the uniform columns: the reader stored their values once.
       m_attributes(m_layout.attributes), m_estimatedNormals(header.estimatedNormals),
       m_cloud(cloud), m_splats(splats) {}
@@ -45,10 +45,12 @@ std::size_t OmhRecordDecoder::store(const std::uint8_t* records, std::size_t cou
             std::memcpy(m_cloud.mutableLasColumn().data() + at * m_layout.point.lasBytes,
                         record + m_layout.point.lasOffset, m_layout.point.lasBytes);
         }
-        m_splats.setEncoded(at, loadRaw<std::uint16_t>(record + m_layout.radiusOffset),
-                            m_estimatedNormals
-                                ? loadRaw<std::uint32_t>(record + m_layout.estimatedNormalOffset)
-                                : 0u);
+        if (m_layout.splats) { // before version 3 (from then on, see readSparseSplats)
+            m_splats.setEncoded(
+                at, loadRaw<std::uint16_t>(record + m_layout.radiusOffset),
+                m_estimatedNormals ? loadRaw<std::uint32_t>(record + m_layout.estimatedNormalOffset)
+                                   : 0u);
+        }
     }
     return firstBad;
 }

@@ -51,7 +51,9 @@ void encodeRecord(const SortedCloud& cloud, const omh::RecordLayout& layout, std
     if (lasBytes != 0) { // no LAS column: no record to copy from
         std::memcpy(record + layout.point.lasOffset, cloud.lasRecord(index), lasBytes);
     }
-    storeRaw(record + layout.radiusOffset, encodedRadius);
+    if (layout.splats) {
+        storeRaw(record + layout.radiusOffset, encodedRadius);
+    }
     if (layout.estimatedNormalOffset != 0) {
         storeRaw(record + layout.estimatedNormalOffset, estimatedNormal);
     }
@@ -78,7 +80,7 @@ void encodeExactRecords(const SortedCloud& cloud, const omh::RecordLayout& layou
     const std::size_t lasBytes = LasBytes != 0 ? LasBytes : layout.point.lasBytes;
     const std::uint8_t* const las = lasBytes != 0 ? cloud.lasColumn().data : nullptr;
     const std::size_t lasStride = cloud.lasColumn().stride;
-    const std::uint16_t* const radii = splats.radii.data();
+    const std::uint16_t* const radii = layout.splats ? splats.radii.data() : nullptr;
     const std::uint32_t* const estimated = splats.normals.empty() ? nullptr : splats.normals.data();
     const std::size_t recordBytes = layout.bytes;
     const std::size_t normalOffset = layout.point.normalOffset;
@@ -102,7 +104,9 @@ void encodeExactRecords(const SortedCloud& cloud, const omh::RecordLayout& layou
         if (las != nullptr) {
             std::memcpy(out + lasOffset, las + index * lasStride, lasBytes);
         }
-        storeRaw(out + radiusOffset, radii[p]);
+        if (radii != nullptr) {
+            storeRaw(out + radiusOffset, radii[p]);
+        }
         if (estimatedOffset != 0) {
             storeRaw(out + estimatedOffset, estimated != nullptr ? estimated[p] : 0u);
         }
@@ -115,8 +119,12 @@ void encodeRecords(const SortedCloud& cloud, const omh::RecordLayout& layout,
                    std::uint32_t last, std::uint8_t* out) {
     if (cloud.positions().empty()) { // the packed store decodes a point at a time anyway
         for (std::uint32_t p = first; p < last; ++p, out += layout.bytes) {
-            encodeRecord<LasBytes>(cloud, layout, node.heldPoint(p), splats.radii[p],
-                                   splats.normals.empty() ? 0u : splats.normals[p], out);
+            encodeRecord<LasBytes>(cloud, layout, node.heldPoint(p),
+                                   layout.splats ? splats.radii[p] : std::uint16_t{0},
+                                   layout.estimatedNormalOffset != 0 && !splats.normals.empty()
+                                       ? splats.normals[p]
+                                       : 0u,
+                                   out);
         }
         return;
     }
@@ -161,8 +169,27 @@ void OmhRecordSink::add(std::uint32_t index, std::uint16_t encodedRadius,
 }
 
 void OmhRecordSink::addNode(const OctreeNode& node, const NodeSplats& splats) {
+    const bool inRecords = m_layout.splats;
     for (std::uint32_t p = 0; p < node.pointCount; ++p) {
-        add(node.heldPoint(p), splats.radii[p], splats.normals.empty() ? 0u : splats.normals[p]);
+        add(node.heldPoint(p), inRecords ? splats.radii[p] : std::uint16_t{0},
+            inRecords && !splats.normals.empty() ? splats.normals[p] : 0u);
+    }
+    addSparseSplats(node, splats);
+}
+
+void OmhRecordSink::addSparseSplats(const OctreeNode& node, const NodeSplats& splats) {
+    if (m_layout.splats || !omh::storesSplats(node.pointCount)) {
+        return;
+    }
+    const std::size_t bytes = omh::splatBytes(m_layout.estimatedNormal);
+    const std::size_t at = m_sparseSplats.size();
+    m_sparseSplats.resize(at + node.pointCount * bytes);
+    std::uint8_t* out = m_sparseSplats.data() + at;
+    for (std::uint32_t p = 0; p < node.pointCount; ++p, out += bytes) {
+        storeRaw(out, splats.radii[p]);
+        if (m_layout.estimatedNormal) {
+            storeRaw(out + sizeof(std::uint16_t), splats.normals.empty() ? 0u : splats.normals[p]);
+        }
     }
 }
 
@@ -173,6 +200,8 @@ void OmhRecordSink::addEncoded(const std::uint8_t* records, std::size_t bytes) {
 
 std::uint64_t OmhRecordSink::finishSection() {
     flush();
+    write(m_sparseSplats.data(), m_sparseSplats.size()); // version 3: after the records
+    m_sparseSplats.clear();
     if (m_positional) {
         m_writeBehind.finish(m_file, m_at);
     }

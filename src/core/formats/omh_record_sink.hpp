@@ -38,13 +38,19 @@ public:
     // One held point (a SortedCloud index) and its splat attributes; `estimatedNormal` is
     // stored only when the layout has room for it.
     void add(std::uint32_t index, std::uint16_t encodedRadius, std::uint32_t estimatedNormal);
-    // Every point `node` holds, with the node's splat attributes, in order.
+    // Every point `node` holds, with the node's splat attributes, in order; from version 3
+    // the attributes are kept for the section's end when the node stores them (addSparseSplats)
+    // and not read otherwise (they may be empty).
     void addNode(const OctreeNode& node, const NodeSplats& splats);
+    // Version 3: keeps the splat attributes of `node`, when it is a sparse node, to be written
+    // after the section's records (finishSection). Nothing otherwise.
+    void addSparseSplats(const OctreeNode& node, const NodeSplats& splats);
 
     // Records encoded elsewhere (encodeOmhRecords), in order after what was added before.
     void addEncoded(const std::uint8_t* records, std::size_t bytes);
 
-    // Writes what is pending and returns the checksum of everything since the last call.
+    // Writes what is pending, then the sparse nodes' splat attributes kept, and returns the
+    // checksum of everything since the last call.
     std::uint64_t finishSection();
 
 private:
@@ -57,6 +63,7 @@ private:
     omh::RecordLayout m_layout;
     std::vector<std::uint8_t> m_block;
     std::size_t m_used = 0;
+    std::vector<std::uint8_t> m_sparseSplats; // version 3: written at the section's end
     std::unique_ptr<oms::PayloadChecksum> m_checksum;
     bool m_positional = false;
     std::uint64_t m_at = 0;    // positional: where the next block goes

@@ -40,10 +40,13 @@ std::uint8_t childMask(const Hierarchy& hierarchy, int level, const OctreeNode& 
 }
 
 // The splat attributes of the nodes in file order, estimated a batch of nodes at a time in
-// parallel (the writer itself is sequential): a save pays for every node's estimate once.
+// parallel (the writer itself is sequential): a save pays once for the estimate of every node
+// whose attributes the file stores (version 3: the sparse nodes').
 class NodeSplatBatches {
 public:
-    explicit NodeSplatBatches(const Hierarchy& hierarchy) : m_hierarchy(hierarchy) {}
+    // Only the nodes whose attributes `layout` stores are estimated.
+    NodeSplatBatches(const Hierarchy& hierarchy, const omh::RecordLayout& layout)
+        : m_hierarchy(hierarchy), m_layout(layout) {}
 
     // Nodes are asked for in order: level by level, each level from index 0.
     const NodeSplats& of(int level, std::size_t index) {
@@ -81,8 +84,10 @@ private:
         readAhead(coveredBegin, coveredEnd(end - 1), points);
         m_batch.resize(end - begin);
         tbb::parallel_for(begin, end, [&](std::size_t i) {
-            m_hierarchy.nodeSplats(m_hierarchy.node(level, i), m_batch[i - begin],
-                                   m_scratch.local());
+            const OctreeNode& node = m_hierarchy.node(level, i);
+            if (omh::storesSplats(m_layout, node.pointCount)) {
+                m_hierarchy.nodeSplats(node, m_batch[i - begin], m_scratch.local());
+            }
             cloud.keepWithinBudget(); // faults may outrun the governor's thread
         });
     }
@@ -103,6 +108,7 @@ private:
     static constexpr std::size_t kDenseStridePoints = 680;
     static constexpr std::size_t kBatchPoints = std::size_t{1} << 20;
     const Hierarchy& m_hierarchy;
+    omh::RecordLayout m_layout;
     tbb::enumerable_thread_specific<SplatScratch> m_scratch;
     std::vector<NodeSplats> m_batch;
     int m_level = -1;
@@ -159,6 +165,9 @@ void writeTopLevelsFromCopy(AtomicFileWriter& file, const Hierarchy& hierarchy,
         tbb::parallel_for(std::size_t{0}, entry.nodes, [&](std::size_t i) {
             nodes[i] = top.node(level, i);
             const OctreeNode& node = hierarchy.node(level, i);
+            if (!omh::storesSplats(layout, node.pointCount)) {
+                return; // the reader estimates them
+            }
             if (node.pointCount < kMinPointsPerSplatEstimate) {
                 // Borrows its shape from its covered range in the source: read in place.
                 hierarchy.nodeSplats(node, levelSplats[i], scratch.local());
@@ -212,8 +221,13 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
         header.uniformColumns |= omh::kUniformLasBit;
         header.uniformLasRecord.assign(cloud.lasRecord(0), cloud.lasRecord(0) + lasBytes);
     }
-    const omh::RecordLayout layout =
-        omh::RecordLayout::of(header.attributes, header.estimatedNormals, header.uniformColumns);
+    if (options.formatVersion != omh::kVersion && options.formatVersion != 2) {
+        fail("cannot write .omh format version " + std::to_string(options.formatVersion) +
+             " (version 2 or " + std::to_string(omh::kVersion) + ")");
+    }
+    header.version = options.formatVersion;
+    const omh::RecordLayout layout = omh::RecordLayout::of(
+        header.attributes, header.estimatedNormals, header.uniformColumns, header.version);
     header.recordBytes = layout.bytes;
     header.cube = cloud.cube();
     header.sourceOffset = cloud.sourceOffset();
@@ -226,6 +240,9 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
             const OctreeNode& node = hierarchy.node(level, i);
             entry.leaves += node.isLeaf() ? 1 : 0;
             entry.points += node.pointCount;
+            if (!layout.splats && omh::storesSplats(node.pointCount)) {
+                entry.sparsePoints += node.pointCount;
+            }
         }
         header.totalNodes += entry.nodes;
         header.totalPoints += entry.points;
@@ -240,7 +257,7 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
         entry.nodeTableOffset = nodeOffset;
         entry.payloadOffset = payloadOffset;
         nodeOffset += entry.nodes * omh::kNodeRecordBytes;
-        payloadOffset += entry.points * layout.bytes;
+        payloadOffset += header.payloadBytes(entry);
     }
 
     AtomicFileWriter file(path);
@@ -248,7 +265,8 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
     file.write(headerBytes.data(), headerBytes.size());
     // The level table holds the sections' checksums, known once they are written: it is
     // written now as a placeholder and overwritten before the file is renamed into place.
-    const std::vector<std::uint8_t> placeholder(omh::encodeLevelTable(header.levels).size(), 0);
+    const std::vector<std::uint8_t> placeholder(
+        omh::encodeLevelTable(header.levels, header.version).size(), 0);
     file.write(placeholder.data(), placeholder.size());
 
     std::vector<std::uint8_t> records;
@@ -313,7 +331,7 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
     const std::unique_ptr<TopLevelPoints> top =
         gather && firstSweptLevel > 0 ? TopLevelPoints::plan(hierarchy, firstSweptLevel) : nullptr;
     const omh::LevelEntry& deepest = header.levels.back();
-    const std::uint64_t payloadEnd = deepest.payloadOffset + deepest.points * layout.bytes;
+    const std::uint64_t payloadEnd = deepest.payloadOffset + header.payloadBytes(deepest);
     if (top) {
         file.extendTo(payloadEnd);
         writeOmhLevelsInOneSweep(file, hierarchy, layout, header.levels, subtrees, firstSweptLevel,
@@ -325,7 +343,7 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
     } else {
         // The top levels a level at a time, appended; their points are few.
         OmhRecordSink sink(file, cloud, layout);
-        NodeSplatBatches splats(hierarchy);
+        NodeSplatBatches splats(hierarchy, layout);
         for (int level = 0; level < firstSweptLevel; ++level) {
             omh::LevelEntry& entry = header.levels[static_cast<std::size_t>(level)];
             for (std::size_t i = 0; i < entry.nodes; ++i) {
@@ -343,7 +361,8 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
 
     const auto footerBytes = omh::encodeFooter(header.totalNodes, header.totalPoints);
     file.write(footerBytes.data(), footerBytes.size());
-    const std::vector<std::uint8_t> levelTable = omh::encodeLevelTable(header.levels);
+    const std::vector<std::uint8_t> levelTable =
+        omh::encodeLevelTable(header.levels, header.version);
     file.writeAt(header.levelTableOffset(), levelTable.data(), levelTable.size());
     file.commit();
 }

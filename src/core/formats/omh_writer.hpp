@@ -27,6 +27,9 @@ struct OmhWriteOptions {
     // the file and write them afterwards (omh_top_levels.hpp) rather than read them in place.
     // The bytes written do not depend on it; tests turn it off.
     bool gatherTopLevels = true;
+    // The format version written: omh::kVersion, or 2 (every record with its splat
+    // attributes, for readers older than version 3).
+    std::uint32_t formatVersion = omh::kVersion;
 };
 
 // The header fields a build determines: its parameters and counts.

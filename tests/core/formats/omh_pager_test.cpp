@@ -155,6 +155,13 @@ TEST(OmhPagedLoad, NodesOnlyAtOpenThenEveryLeafOnDemandEqualToTheWholeLoad) {
     settlePaged(front, lookingAt({0.5, 0.5, 0.5}, 0.5, 1e9), fullDetail());
     EXPECT_EQ(front.entries().size(), leafCount(*paged));
     expectFrontPointsEqual(front, *paged, *whole);
+    // Among them nodes too sparse for an estimate, whose stored attributes the pager reads.
+    EXPECT_GT(std::count_if(front.entries().begin(), front.entries().end(),
+                            [&](const FrontEntry& entry) {
+                                return paged->node(entry.level(), entry.index).pointCount <
+                                       kMinPointsPerSplatEstimate;
+                            }),
+              0);
     const ResidencyStats stats = paged->residency()->stats();
     EXPECT_EQ(stats.evictions, 0u);
     EXPECT_EQ(stats.failedNodes, 0u);

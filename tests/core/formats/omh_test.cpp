@@ -26,9 +26,12 @@ BuildOptions options(int depth, LeafCollapse collapse) {
     return o;
 }
 
-void save(const std::string& path, const BuildResult& built) {
+void save(const std::string& path, const BuildResult& built,
+          std::uint32_t formatVersion = omh::kVersion) {
+    OmhWriteOptions options;
+    options.formatVersion = formatVersion;
     writeOmh(path, built.builder->hierarchy(),
-             omhBuildInfo(built.builder->options(), built.builder->statistics()));
+             omhBuildInfo(built.builder->options(), built.builder->statistics()), options);
 }
 
 std::shared_ptr<const Hierarchy> loadAll(const std::string& path) {
@@ -71,7 +74,9 @@ void expectSameHierarchy(const Hierarchy& built, const Hierarchy& loaded) {
             ASSERT_EQ(y.coveredBegin, nextLoadedPoint) << "nodes hold consecutive ranges";
             ASSERT_EQ(y.coveredCount, y.pointCount);
             nextLoadedPoint += y.pointCount;
-            // The file stores the built hierarchy's estimates: the loaded node reads them back.
+            // The file stores the built hierarchy's estimates (from version 3 only a sparse
+            // node's) and the loaded node reads them back, or estimates them again from the
+            // same points: the same bytes either way.
             built.nodeSplats(x, builtSplats, scratch);
             loaded.nodeSplats(y, loadedSplats, scratch);
             ASSERT_EQ(builtSplats.radii, loadedSplats.radii);
@@ -297,6 +302,10 @@ struct SmallFile {
             return "footer";
         }
         for (std::size_t l = header.levels.size(); l-- > 0;) {
+            if (offset >= header.sparseSplatsOffset(header.levels[l])) {
+                // A damaged byte here fails the level's checksum, which names both parts.
+                return "sparse nodes' splat attributes of level " + std::to_string(l);
+            }
             if (offset >= header.levels[l].payloadOffset) {
                 return "point records of level " + std::to_string(l);
             }
@@ -344,7 +353,8 @@ SyntheticCloud withLasColumns(bool uniformIntensity, bool uniformLas,
 TEST(OmhUniformColumns, AreStoredOnceInTheHeaderAndLoadBitExact) {
     TempDir dir;
     const std::size_t fullRecord =
-        omh::RecordLayout::of(withLasColumns(false, false).info.attributes, true).bytes;
+        omh::RecordLayout::of(withLasColumns(false, false).info.attributes, true, 0, omh::kVersion)
+            .bytes;
     for (const bool uniformIntensity : {false, true}) {
         for (const bool uniformLas : {false, true}) {
             SCOPED_TRACE(std::string(uniformIntensity ? "uniform" : "varying") + " intensity, " +
@@ -397,7 +407,7 @@ TEST(OmhUniformColumns, AVersion1FileStillLoads) {
     TempDir dir;
     // Without uniform columns a version 2 file is a version 1 file but for its version.
     const BuildResult built = buildSynthetic(withLasColumns(false, false), options(4, {}));
-    save(dir.file("v2.omh"), built);
+    save(dir.file("v2.omh"), built, 2);
     const std::string v1 = dir.file("v1.omh");
     writeBytes(v1, withHeaderByte(readBytes(dir.file("v2.omh")), omh::header::kVersion, 1));
     OmhReader reader(v1);
@@ -410,6 +420,127 @@ TEST(OmhUniformColumns, AVersion1FileStillLoads) {
         v1, withHeaderByte(readBytes(v1), omh::header::kUniformColumns, omh::kUniformIntensityBit));
     EXPECT_NE(loadError(v1).find("expected reserved bytes 130-247 to be zero"), std::string::npos)
         << loadError(v1);
+}
+
+// ---- Splat attributes out of the records (version 3) ----
+
+// `bytes` with the level table of `levels` (its checksum made right) in place of theirs.
+void putLevelTable(std::vector<std::uint8_t>& bytes, const std::vector<omh::LevelEntry>& levels,
+                   std::uint32_t version) {
+    const std::vector<std::uint8_t> table = omh::encodeLevelTable(levels, version);
+    std::copy(table.begin(), table.end(), bytes.begin() + omh::kHeaderBytes);
+}
+
+// Points held by the nodes of `level` too sparse for an estimate of their own.
+std::uint64_t sparsePointsOf(const Hierarchy& hierarchy, int level) {
+    std::uint64_t points = 0;
+    for (std::size_t i = 0; i < hierarchy.nodeCount(level); ++i) {
+        const std::uint32_t count = hierarchy.node(level, i).pointCount;
+        points += count < kMinPointsPerSplatEstimate ? count : 0;
+    }
+    return points;
+}
+
+TEST(OmhVersion3, StoresSplatAttributesOnlyForSparseNodesAndLoadsTheBuildsBitForBit) {
+    TempDir dir;
+    for (const bool normals : {false, true}) {
+        SCOPED_TRACE(normals ? "with normals" : "estimated normals");
+        const SyntheticCloud cloud = makeCloud(Shape::Plane, 20000, 17, normals);
+        const BuildResult built = buildSynthetic(cloud, options(5, {}));
+        const Hierarchy& hierarchy = built.builder->hierarchy();
+        ASSERT_NO_FATAL_FAILURE(expectRoundTrip(built, dir));
+        const omh::Header header = OmhReader(dir.file("first.omh")).header();
+        EXPECT_EQ(header.version, 3u);
+        EXPECT_FALSE(header.splatsInRecords());
+        EXPECT_EQ(header.estimatedNormals, !normals);
+        EXPECT_EQ(header.recordBytes, oms::RecordLayout::of(header.attributes).bytes);
+        std::uint64_t sparse = 0;
+        for (int level = 0; level <= hierarchy.maxLevel(); ++level) {
+            const omh::LevelEntry& entry = header.levels[static_cast<std::size_t>(level)];
+            EXPECT_EQ(entry.sparsePoints, sparsePointsOf(hierarchy, level)) << "level " << level;
+            sparse += entry.sparsePoints;
+        }
+        ASSERT_GT(sparse, 0u) << "no sparse node: the stored attributes went untested";
+        ASSERT_LT(sparse, header.totalPoints / 10) << "most nodes are estimated again";
+        EXPECT_EQ(readBytes(dir.file("first.omh")).size(),
+                  omh::kHeaderBytes + header.levels.size() * 64 + 8 +
+                      header.totalNodes * omh::kNodeRecordBytes +
+                      header.totalPoints * header.recordBytes + sparse * (normals ? 2u : 6u) +
+                      omh::kFooterBytes);
+    }
+}
+
+TEST(OmhVersion3, AVersion2FileStillLoadsWithTheSplatAttributesItsRecordsCarry) {
+    TempDir dir;
+    const BuildResult built = buildSynthetic(withLasColumns(false, true), options(5, {}));
+    save(dir.file("v2.omh"), built, 2);
+    save(dir.file("v3.omh"), built);
+    OmhReader reader(dir.file("v2.omh"));
+    const omh::Header& v2 = reader.header();
+    EXPECT_EQ(v2.version, 2u);
+    EXPECT_TRUE(v2.splatsInRecords());
+    const omh::Header v3 = OmhReader(dir.file("v3.omh")).header();
+    EXPECT_EQ(v2.recordBytes, v3.recordBytes + v3.splatBytes());
+    for (const omh::LevelEntry& level : v2.levels) {
+        EXPECT_EQ(level.sparsePoints, 0u);
+    }
+    const auto loaded = reader.hierarchy();
+    reader.load();
+    ASSERT_NO_FATAL_FAILURE(expectSameHierarchy(built.builder->hierarchy(), *loaded));
+    // Saved again, a version 2 file becomes the version 3 file of the same hierarchy.
+    writeOmh(dir.file("again.omh"), *loaded, v2.build);
+    EXPECT_EQ(readBytes(dir.file("again.omh")), readBytes(dir.file("v3.omh")));
+    // Its splat attributes are what it stores, not an estimate: a changed radius is drawn.
+    std::vector<std::uint8_t> bytes = readBytes(dir.file("v2.omh"));
+    const omh::LevelEntry& deepest = v2.levels.back();
+    const std::uint64_t radius =
+        deepest.payloadOffset +
+        omh::RecordLayout::of(v2.attributes, v2.estimatedNormals, v2.uniformColumns, 2)
+            .radiusOffset;
+    bytes[radius] ^= 0x01;
+    // The level's checksum, made right again.
+    oms::PayloadChecksum checksum;
+    checksum.update(bytes.data() + deepest.payloadOffset, v2.payloadBytes(deepest));
+    std::vector<omh::LevelEntry> levels = v2.levels;
+    levels.back().payloadChecksum = checksum.digest();
+    putLevelTable(bytes, levels, 2);
+    writeBytes(dir.file("changed.omh"), bytes);
+    const auto changedLoad = loadAll(dir.file("changed.omh"));
+    const Hierarchy& original = built.builder->hierarchy();
+    const int level = original.maxLevel();
+    NodeSplats a, b;
+    SplatScratch scratch;
+    original.nodeSplats(original.node(level, 0), a, scratch);
+    changedLoad->nodeSplats(changedLoad->node(level, 0), b, scratch);
+    ASSERT_FALSE(a.radii.empty());
+    EXPECT_EQ(b.radii[0], a.radii[0] ^ 0x01);
+}
+
+TEST(OmhVersion3, ASparseNodeCountThatDisagreesWithTheNodeTableIsAClearError) {
+    SmallFile file;
+    std::size_t level = 0;
+    while (level < file.header.levels.size() && file.header.levels[level].sparsePoints == 0) {
+        ++level;
+    }
+    ASSERT_LT(level, file.header.levels.size()) << "the small file has no sparse node";
+    // One point fewer declared sparse, its attributes dropped and the offsets after them moved
+    // (and the level table's checksum made right): the file's size agrees with its level
+    // table, and only the node table disagrees.
+    std::vector<omh::LevelEntry> levels = file.header.levels;
+    levels[level].sparsePoints -= 1;
+    for (std::size_t l = level + 1; l < levels.size(); ++l) {
+        levels[l].payloadOffset -= file.header.splatBytes();
+    }
+    std::vector<std::uint8_t> bytes = file.bytes;
+    const std::uint64_t cut = file.header.sparseSplatsOffset(file.header.levels[level]);
+    bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(cut),
+                bytes.begin() + static_cast<std::ptrdiff_t>(cut + file.header.splatBytes()));
+    putLevelTable(bytes, levels, omh::kVersion);
+    const std::string bad = file.dir.file("bad.omh");
+    writeBytes(bad, bytes);
+    const std::string message = loadError(bad);
+    EXPECT_NE(message.find(bad), std::string::npos) << message;
+    EXPECT_NE(message.find("the nodes of fewer than 8 points hold"), std::string::npos) << message;
 }
 
 TEST(OmhUniformColumns, BadUniformFieldsAreClearErrors) {
@@ -432,7 +563,7 @@ TEST(OmhUniformColumns, BadUniformFieldsAreClearErrors) {
     expectError(withHeaderByte(plain, omh::header::kUniformColumns, omh::kUniformLasBit),
                 "a uniform LAS column is declared");
     expectError(withHeaderByte(plain, omh::header::kReserved2, 1), "reserved zero byte");
-    expectError(withHeaderByte(plain, omh::header::kVersion, 3), "format version 1 to 2, found 3");
+    expectError(withHeaderByte(plain, omh::header::kVersion, 4), "format version 1 to 3, found 4");
     // The uniform LAS record ends at byte 134 + 16: a byte after it must be zero.
     expectError(withHeaderByte(uniform, omh::header::kUniformLasRecord + 16, 9),
                 "expected reserved bytes 150-247 to be zero");
@@ -476,6 +607,9 @@ TEST(OmhDamage, TruncationAtEverySectionBoundaryIsAClearError) {
     for (const omh::LevelEntry& level : file.header.levels) {
         boundaries.push_back(level.nodeTableOffset);
         boundaries.push_back(level.payloadOffset);
+        if (level.sparsePoints > 0) {
+            boundaries.push_back(file.header.sparseSplatsOffset(level));
+        }
     }
     const std::string cut = file.dir.file("cut.omh");
     for (std::uint64_t size : boundaries) {
