@@ -17,10 +17,12 @@ constexpr double kEvictTo = 0.875;
 } // namespace
 
 std::uint64_t OmhPager::residentBytesPerPoint(const omh::Header& header) {
-    // The cloud's point (but its uniform columns, stored once), then the stored splat radius
-    // and estimated normal.
+    // The cloud's point (but its uniform columns, stored once), then before version 3 the
+    // stored splat radius and estimated normal. From version 3 only the few points of sparse
+    // nodes have them stored; the others' are estimated when drawn, into the renderer's
+    // buffers, and their pages of the splat arrays are never touched.
     return pointBytes(omh::recordAttributes(header.attributes, header.uniformColumns)) +
-           sizeof(std::uint16_t) + (header.estimatedNormals ? sizeof(std::uint32_t) : 0);
+           (header.splatsInRecords() ? header.splatBytes() : 0);
 }
 
 OmhPager::OmhPager(const omh::Header& header, std::shared_ptr<SortedCloud> cloud,

@@ -47,7 +47,7 @@ namespace omicron {
 
 class OmhPager final : public NodeResidency {
 public:
-    // Bytes a point takes in memory (cloud attributes and splat attributes).
+    // Bytes a point takes in memory (cloud attributes, and splat attributes before version 3).
     static std::uint64_t residentBytesPerPoint(const omh::Header& header);
 
     // `cloud` and `hierarchy` are the ones OmhReader made for `header`'s file (a cloud with
