@@ -3,7 +3,6 @@
 #include "formats/omh_reader.hpp"
 #include "formats/omh_record_decoder.hpp"
 #include "io/input_error.hpp"
-#include "io/raw_bytes.hpp"
 
 #include <algorithm>
 
@@ -242,13 +241,7 @@ void OmhPager::loadSparseSplats(int level, std::uint32_t index, const OctreeNode
     m_records.resize(std::size_t{node.pointCount} * splatBytes);
     m_stream.seek(offset);
     m_stream.readExact(m_records.data(), m_records.size(), omhSectionAt(m_header, offset));
-    StoredSplats& splats = m_hierarchy.mutableStoredSplats();
-    for (std::uint32_t p = 0; p < node.pointCount; ++p) {
-        const std::uint8_t* at = m_records.data() + p * splatBytes;
-        splats.setEncoded(
-            node.coveredBegin + p, loadRaw<std::uint16_t>(at),
-            m_header.estimatedNormals ? loadRaw<std::uint32_t>(at + sizeof(std::uint16_t)) : 0u);
-    }
+    m_decoder.storeSparseSplats(m_records.data(), node.pointCount, node.coveredBegin);
     m_bytesRead.fetch_add(m_records.size(), std::memory_order_relaxed);
 }
 

@@ -599,7 +599,7 @@ void OmhReader::readPoints(int level, const std::vector<OctreeNode>& nodes,
         }
         begin += count;
     }
-    readSparseSplats(level, nodes, checksum);
+    readSparseSplats(level, nodes, decoder, checksum);
     const std::uint64_t digest = checksum.digest();
     if (digest != entry.payloadChecksum) {
         throw InputError(InputErrorKind::MalformedValue, m_header.path,
@@ -613,7 +613,7 @@ void OmhReader::readPoints(int level, const std::vector<OctreeNode>& nodes,
 }
 
 void OmhReader::readSparseSplats(int level, const std::vector<OctreeNode>& nodes,
-                                 oms::PayloadChecksum& checksum) {
+                                 const OmhRecordDecoder& decoder, oms::PayloadChecksum& checksum) {
     const omh::LevelEntry& entry = m_header.levels[static_cast<std::size_t>(level)];
     if (entry.sparsePoints == 0) {
         return;
@@ -621,7 +621,6 @@ void OmhReader::readSparseSplats(int level, const std::vector<OctreeNode>& nodes
     const std::string section = omhSectionAt(m_header, m_header.sparseSplatsOffset(entry));
     const std::size_t splatBytes = m_header.splatBytes();
     const std::size_t blockPoints = kBlockBytes / splatBytes;
-    StoredSplats& splats = m_hierarchy->mutableStoredSplats();
     auto node = nodes.begin();
     std::uint32_t inNode = 0; // the next point of *node, a sparse node
     const auto nextSparse = [&] {
@@ -637,11 +636,8 @@ void OmhReader::readSparseSplats(int level, const std::vector<OctreeNode>& nodes
         m_stream.readExact(m_block.data(), m_block.size(), section);
         checksum.update(m_block.data(), m_block.size());
         for (std::size_t p = 0; p < count; ++p) {
-            const std::uint8_t* at = m_block.data() + p * splatBytes;
-            splats.setEncoded(node->coveredBegin + inNode, loadRaw<std::uint16_t>(at),
-                              m_header.estimatedNormals
-                                  ? loadRaw<std::uint32_t>(at + sizeof(std::uint16_t))
-                                  : 0u);
+            decoder.storeSparseSplats(m_block.data() + p * splatBytes, 1,
+                                      node->coveredBegin + inNode);
             if (++inNode == node->pointCount && begin + p + 1 < entry.sparsePoints) {
                 ++node;
                 inNode = 0;

@@ -27,6 +27,8 @@
 
 namespace omicron {
 
+class OmhRecordDecoder;
+
 // True when `path` should be opened with OmhReader: its first 8 bytes are the .omh magic, or
 // its name ends in ".omh" (any case). Never throws.
 bool isOmhFile(const std::string& path);
@@ -75,7 +77,7 @@ private:
     void readPoints(int level, const std::vector<OctreeNode>& nodes, std::uint64_t firstPoint);
     // Version 3: the splat attributes of the level's sparse nodes, after its records.
     void readSparseSplats(int level, const std::vector<OctreeNode>& nodes,
-                          oms::PayloadChecksum& checksum);
+                          const OmhRecordDecoder& decoder, oms::PayloadChecksum& checksum);
 
     FileStream m_stream;
     omh::Header m_header;

@@ -55,6 +55,16 @@ std::size_t OmhRecordDecoder::store(const std::uint8_t* records, std::size_t cou
     return firstBad;
 }
 
+void OmhRecordDecoder::storeSparseSplats(const std::uint8_t* bytes, std::size_t count,
+                                         std::size_t point) const {
+    const std::size_t stride = omh::splatBytes(m_estimatedNormals);
+    for (std::size_t p = 0; p < count; ++p, bytes += stride) {
+        m_splats.setEncoded(
+            point + p, loadRaw<std::uint16_t>(bytes),
+            m_estimatedNormals ? loadRaw<std::uint32_t>(bytes + sizeof(std::uint16_t)) : 0u);
+    }
+}
+
 InputError OmhRecordDecoder::misplaced(int level, std::uint64_t recordInLevel,
                                        morton::Code nodeCode) const {
     const std::uint64_t byte = m_header.levels[static_cast<std::size_t>(level)].payloadOffset +

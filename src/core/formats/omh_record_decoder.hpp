@@ -25,6 +25,10 @@ public:
     std::size_t store(const std::uint8_t* records, std::size_t count, std::size_t point,
                       morton::Code nodeCode, int level) const;
 
+    // Version 3: the splat attributes of `count` points of a sparse node, as its level stores
+    // them after its records (omh::splatBytes each), for the cloud's points [point, ...).
+    void storeSparseSplats(const std::uint8_t* bytes, std::size_t count, std::size_t point) const;
+
     std::size_t recordBytes() const { return m_layout.bytes; }
 
     // The error for record `recordInLevel` of `level` that store() found outside the cell of
