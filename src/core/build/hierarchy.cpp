@@ -11,7 +11,8 @@ Hierarchy::Hierarchy(std::shared_ptr<const SortedCloud> cloud, int maxLevel,
                      SplatSource splatSource)
     : m_cloud(std::move(cloud)), m_maxLevel(maxLevel), m_insertions(m_cloud->capacity()),
       m_storedSplats(splatSource != SplatSource::Estimated
-                         ? std::make_unique<StoredSplats>(*m_cloud)
+                         ? std::make_unique<StoredSplats>(
+                               *m_cloud, splatSource == SplatSource::StoredForSparseNodes)
                          : nullptr),
       m_storedForSparseNodesOnly(splatSource == SplatSource::StoredForSparseNodes) {
     assert(maxLevel >= 0 && maxLevel <= morton::kMaxLevel);

@@ -1,8 +1,9 @@
 // The splat attributes a saved hierarchy carries, per point of its node-order cloud.
 //
 // A built hierarchy estimates the attributes of a node when it is drawn or saved
-// (splat_estimator.hpp); a hierarchy loaded from a .omh file has them already, one record per
-// held point, so the loader stores them here and the renderer reads them instead of estimating.
+// (splat_estimator.hpp); a hierarchy loaded from a .omh file has some already, so the loader
+// stores them here and the renderer reads them instead of estimating: before version 3 every
+// held point's, from version 3 only those of nodes too sparse for an estimate of their own.
 //
 // Memory: 2 bytes per point for the radius plus 4 bytes per point for an estimated normal only
 // when the cloud has no normals of its own.
@@ -19,13 +20,14 @@ namespace omicron {
 
 class StoredSplats {
 public:
-    // Allocates the per-point arrays for the cloud's full capacity (small pages for a cloud
-    // paged in on demand, so a node's attributes are released with its points).
-    explicit StoredSplats(const SortedCloud& cloud)
-        : m_capacity(cloud.capacity()),
-          m_radii(m_capacity, cloud.pagedOnDemand() ? PageSize::Small : PageSize::Huge),
+    // Allocates the per-point arrays for the cloud's full capacity, in small pages for a cloud
+    // paged in on demand (so a node's attributes are released with its points) and where only
+    // the few points of sparse nodes are stored (`sparseNodesOnly`, a version 3 .omh: the
+    // pages nothing writes stay unmapped, where a huge page would map 2 MiB around each).
+    StoredSplats(const SortedCloud& cloud, bool sparseNodesOnly)
+        : m_capacity(cloud.capacity()), m_radii(m_capacity, pageSize(cloud, sparseNodesOnly)),
           m_normals(cloud.attributes().has(Attribute::Normal) ? 0 : m_capacity,
-                    cloud.pagedOnDemand() ? PageSize::Small : PageSize::Huge) {}
+                    pageSize(cloud, sparseNodesOnly)) {}
 
     StoredSplats(const StoredSplats&) = delete;
     StoredSplats& operator=(const StoredSplats&) = delete;
@@ -53,6 +55,10 @@ public:
     }
 
 private:
+    static PageSize pageSize(const SortedCloud& cloud, bool sparseNodesOnly) {
+        return cloud.pagedOnDemand() || sparseNodesOnly ? PageSize::Small : PageSize::Huge;
+    }
+
     std::size_t m_capacity;
     // Left uninitialised: the loader writes every point of a level before publishing it.
     HugePageArray<std::uint16_t> m_radii;
