@@ -13,8 +13,7 @@ Hierarchy::Hierarchy(std::shared_ptr<const SortedCloud> cloud, int maxLevel,
       m_storedSplats(splatSource != SplatSource::Estimated
                          ? std::make_unique<StoredSplats>(
                                *m_cloud, splatSource == SplatSource::StoredForSparseNodes)
-                         : nullptr),
-      m_storedForSparseNodesOnly(splatSource == SplatSource::StoredForSparseNodes) {
+                         : nullptr) {
     assert(maxLevel >= 0 && maxLevel <= morton::kMaxLevel);
     m_levels.reserve(static_cast<std::size_t>(maxLevel) + 1);
     for (int level = 0; level <= maxLevel; ++level) {
@@ -49,7 +48,7 @@ std::optional<std::size_t> Hierarchy::findNode(morton::Code code, std::size_t co
 
 void Hierarchy::nodeSplats(const OctreeNode& node, NodeSplats& out, SplatScratch& scratch) const {
     if (!m_storedSplats ||
-        (m_storedForSparseNodesOnly && node.pointCount >= kMinPointsPerSplatEstimate)) {
+        (m_storedSplats->sparseNodesOnly() && node.pointCount >= kMinPointsPerSplatEstimate)) {
         // Finding the region costs two searches of the cloud: only for the nodes that use it.
         const SparseSplatRegion region = node.pointCount < kMinPointsPerSplatEstimate
                                              ? sparseSplatRegion(node)

@@ -198,7 +198,6 @@ private:
     InsertionLog m_insertions; // every leaf covers at least one point: capacity = the cloud's
     SampleStore m_samples;
     std::unique_ptr<StoredSplats> m_storedSplats; // SplatSource::Stored*
-    bool m_storedForSparseNodesOnly = false;
     std::atomic<morton::Code> m_cutDelimiter{0};
     std::atomic<std::uint64_t> m_epoch{0};
     std::atomic<bool> m_complete{false};

@@ -25,7 +25,8 @@ public:
     // the few points of sparse nodes are stored (`sparseNodesOnly`, a version 3 .omh: the
     // pages nothing writes stay unmapped, where a huge page would map 2 MiB around each).
     StoredSplats(const SortedCloud& cloud, bool sparseNodesOnly)
-        : m_capacity(cloud.capacity()), m_radii(m_capacity, pageSize(cloud, sparseNodesOnly)),
+        : m_capacity(cloud.capacity()), m_sparseNodesOnly(sparseNodesOnly),
+          m_radii(m_capacity, pageSize(cloud, sparseNodesOnly)),
           m_normals(cloud.attributes().has(Attribute::Normal) ? 0 : m_capacity,
                     pageSize(cloud, sparseNodesOnly)) {}
 
@@ -33,6 +34,8 @@ public:
     StoredSplats& operator=(const StoredSplats&) = delete;
 
     bool estimatesNormals() const { return m_normals.size() != 0; }
+    // Only the points of nodes too sparse for an estimate of their own have attributes here.
+    bool sparseNodesOnly() const { return m_sparseNodesOnly; }
     // Valid for points of published levels.
     std::uint16_t encodedRadius(std::size_t point) const { return m_radii[point]; }
     // Only when estimatesNormals().
@@ -60,6 +63,7 @@ private:
     }
 
     std::size_t m_capacity;
+    bool m_sparseNodesOnly;
     // Left uninitialised: the loader writes every point of a level before publishing it.
     HugePageArray<std::uint16_t> m_radii;
     HugePageArray<std::uint32_t> m_normals; // empty when the cloud has normals

@@ -622,26 +622,26 @@ void OmhReader::readSparseSplats(int level, const std::vector<OctreeNode>& nodes
     const std::size_t splatBytes = m_header.splatBytes();
     const std::size_t blockPoints = kBlockBytes / splatBytes;
     auto node = nodes.begin();
-    std::uint32_t inNode = 0; // the next point of *node, a sparse node
-    const auto nextSparse = [&] {
-        while (!omh::storesSplats(node->pointCount)) {
-            ++node; // readNodes counted entry.sparsePoints points in such nodes
-        }
-    };
-    nextSparse();
+    std::uint32_t inNode = 0; // the next point of *node
     for (std::uint64_t begin = 0; begin < entry.sparsePoints;) {
         const std::size_t count = static_cast<std::size_t>(
             std::min<std::uint64_t>(blockPoints, entry.sparsePoints - begin));
         m_block.resize(count * splatBytes);
         m_stream.readExact(m_block.data(), m_block.size(), section);
         checksum.update(m_block.data(), m_block.size());
-        for (std::size_t p = 0; p < count; ++p) {
-            decoder.storeSparseSplats(m_block.data() + p * splatBytes, 1,
+        // The block's attributes, sparse node by sparse node (readNodes counted them).
+        for (std::size_t p = 0; p < count;) {
+            while (!omh::storesSplats(node->pointCount)) {
+                ++node;
+            }
+            const std::size_t run = std::min<std::size_t>(count - p, node->pointCount - inNode);
+            decoder.storeSparseSplats(m_block.data() + p * splatBytes, run,
                                       node->coveredBegin + inNode);
-            if (++inNode == node->pointCount && begin + p + 1 < entry.sparsePoints) {
+            p += run;
+            inNode += static_cast<std::uint32_t>(run);
+            if (inNode == node->pointCount) {
                 ++node;
                 inNode = 0;
-                nextSparse();
             }
         }
         begin += count;

@@ -19,6 +19,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <initializer_list>
 #include <optional>
 #include <tbb/enumerable_thread_specific.h>
 
@@ -215,6 +216,12 @@ private:
     // nullopt when they do not read the file's type.
     std::optional<FloatRecordLayout::Normals> fastNormals() const;
     std::optional<FloatRecordLayout::Color> fastColors() const;
+    // fastNormals and fastColors: None when the file has no such fields, else the loops' type
+    // paired with the first of `types` all three of `fields` have, or nullopt.
+    template <typename Loops>
+    std::optional<Loops>
+    fastTriple(bool present, const std::array<int, 3>& fields,
+               std::initializer_list<std::pair<PlyScalarType, Loops>> types) const;
     std::optional<FloatRecordLayout::Intensity> fastIntensity() const;
     bool fastLayout() const;
     FloatRecordLayout floatLayout() const;
@@ -762,35 +769,34 @@ bool PlyReader::fastPositions() const {
             hasType(m_fields.position, PlyScalarType::Float64));
 }
 
-std::optional<FloatRecordLayout::Normals> PlyReader::fastNormals() const {
-    using Normals = FloatRecordLayout::Normals;
-    if (!m_fields.hasNormals()) {
-        return Normals::None;
+template <typename Loops>
+std::optional<Loops>
+PlyReader::fastTriple(bool present, const std::array<int, 3>& fields,
+                      std::initializer_list<std::pair<PlyScalarType, Loops>> types) const {
+    if (!present) {
+        return Loops::None;
     }
-    if (hasType(m_fields.normal, PlyScalarType::Float32)) {
-        return Normals::Float;
-    }
-    if (hasType(m_fields.normal, PlyScalarType::Float64)) {
-        return Normals::Double;
+    for (const auto& [type, loops] : types) {
+        if (hasType(fields, type)) {
+            return loops;
+        }
     }
     return std::nullopt;
 }
 
+std::optional<FloatRecordLayout::Normals> PlyReader::fastNormals() const {
+    using Normals = FloatRecordLayout::Normals;
+    return fastTriple<Normals>(
+        m_fields.hasNormals(), m_fields.normal,
+        {{PlyScalarType::Float32, Normals::Float}, {PlyScalarType::Float64, Normals::Double}});
+}
+
 std::optional<FloatRecordLayout::Color> PlyReader::fastColors() const {
     using Color = FloatRecordLayout::Color;
-    if (!m_fields.hasColors()) {
-        return Color::None;
-    }
-    if (hasType(m_fields.color, PlyScalarType::UInt8)) {
-        return Color::UChar;
-    }
-    if (hasType(m_fields.color, PlyScalarType::UInt16)) {
-        return Color::UShort;
-    }
-    if (hasType(m_fields.color, PlyScalarType::Float32)) {
-        return Color::Float;
-    }
-    return std::nullopt;
+    return fastTriple<Color>(m_fields.hasColors(), m_fields.color,
+                             {{PlyScalarType::UInt8, Color::UChar},
+                              {PlyScalarType::UInt16, Color::UShort},
+                              {PlyScalarType::Float32, Color::Float}});
 }
 
 std::optional<FloatRecordLayout::Intensity> PlyReader::fastIntensity() const {
