@@ -4,16 +4,12 @@
 
 #include <algorithm>
 #include <cassert>
+#include <functional>
+#include <iterator>
 #include <new>
 #include <sys/mman.h>
 
 namespace omicron {
-
-namespace {
-
-constexpr std::size_t kBlocksPerSlab = 1024;
-
-} // namespace
 
 BinBlockPool::BinBlockPool(std::size_t blockBytes)
     : m_blockBytes(blockBytes), m_slabBytes(blockBytes * kBlocksPerSlab),
@@ -43,17 +39,48 @@ void* BinBlockPool::allocate() {
     return block;
 }
 
-void BinBlockPool::release(std::vector<void*> blocks) const {
-    std::sort(blocks.begin(), blocks.end());
-    for (std::size_t i = 0; i < blocks.size();) {
-        std::size_t end = i + 1;
-        while (end < blocks.size() &&
-               blocks[end] == static_cast<std::byte*>(blocks[end - 1]) + m_blockBytes) {
-            ++end;
+std::size_t BinBlockPool::slabOf(const void* block) {
+    if (m_slabsByAddress.size() != m_slabs.size()) { // slabs were mapped since the last call
+        m_slabsByAddress.resize(m_slabs.size());
+        for (std::size_t s = 0; s < m_slabs.size(); ++s) {
+            m_slabsByAddress[s] = s;
         }
-        releasePages(blocks[i], (end - i) * m_blockBytes);
-        i = end;
+        std::sort(
+            m_slabsByAddress.begin(), m_slabsByAddress.end(),
+            [this](std::size_t a, std::size_t b) { return std::less<>()(m_slabs[a], m_slabs[b]); });
     }
+    // The last slab that starts at or before the block.
+    const auto after = std::upper_bound(
+        m_slabsByAddress.begin(), m_slabsByAddress.end(), block,
+        [this](const void* at, std::size_t s) { return std::less<>()(at, m_slabs[s]); });
+    assert(after != m_slabsByAddress.begin());
+    const std::size_t slab = *std::prev(after);
+    assert(static_cast<const std::byte*>(block) <
+           static_cast<const std::byte*>(m_slabs[slab]) + m_slabBytes);
+    return slab;
+}
+
+void BinBlockPool::release(const std::vector<void*>& blocks) {
+    m_releasedBlocks.resize(m_slabs.size(), 0);
+    for (const void* block : blocks) {
+        const std::size_t slab = slabOf(block);
+        const std::size_t carved =
+            slab + 1 == m_slabs.size() ? m_usedInLastSlab / m_blockBytes : kBlocksPerSlab;
+        assert(m_releasedBlocks[slab] < carved);
+        if (++m_releasedBlocks[slab] == carved) {
+            releasePages(m_slabs[slab], carved * m_blockBytes);
+        }
+    }
+}
+
+std::size_t BinBlockPool::releasedSlabCount() const {
+    std::size_t released = 0;
+    for (std::size_t slab = 0; slab < m_releasedBlocks.size(); ++slab) {
+        const std::size_t carved =
+            slab + 1 == m_slabs.size() ? m_usedInLastSlab / m_blockBytes : kBlocksPerSlab;
+        released += m_releasedBlocks[slab] == carved ? 1 : 0;
+    }
+    return released;
 }
 
 } // namespace omicron

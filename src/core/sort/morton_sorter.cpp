@@ -367,7 +367,7 @@ void IncrementalMortonSorter::releaseBins(std::size_t first, std::size_t end) {
         blocks.insert(blocks.end(), m_bins[bin].blocks.begin(), m_bins[bin].blocks.end());
         m_bins[bin] = Bin{};
     }
-    m_binBlocks.release(std::move(blocks));
+    m_binBlocks.release(blocks);
 }
 
 void IncrementalMortonSorter::prepareRecycledPages(const SortedCloud::StagedRange& out) {
@@ -474,8 +474,9 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                                       std::span(keyScratch.get() + at, n),
                                       std::span(indexScratch.get() + at, n));
                    });
-                   // Sorted bins are not read again: their blocks go back now, so the sorted
-                   // cloud filling up reuses the memory instead of raising the peak.
+                   // Sorted bins are not read again: their blocks go back, a slab at a time
+                   // as slabs empty, so what fills up meanwhile reuses the memory instead of
+                   // raising the peak.
                    releaseBins(boundaries[c], boundaries[c + 1]);
                    // Gather every attribute into its sorted place.
                    const SortedCloud::StagedRange out = cloud.stage(chunkBegin[c + 1]);

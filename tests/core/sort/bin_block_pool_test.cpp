@@ -1,5 +1,6 @@
-// The sorter's bin blocks: distinct page-aligned blocks across slabs, whose pages go back to
-// the kernel when released (checked with mincore) while the others keep their contents.
+// The sorter's bin blocks: distinct page-aligned blocks across slabs; a slab's pages go back to
+// the kernel when its last block is released (checked with mincore), and until then every
+// block keeps its contents.
 #include "sort/bin_block_pool.hpp"
 
 #include <cstdint>
@@ -51,26 +52,53 @@ TEST(BinBlockPool, BlocksAreDistinctAlignedAndSpanSlabs) {
     }
 }
 
-TEST(BinBlockPool, ReleasedBlocksGiveTheirPagesBackAndOthersKeepTheirs) {
+TEST(BinBlockPool, ASlabsPagesGoBackWhenItsLastBlockIsGivenBack) {
     BinBlockPool pool(kBlockBytes);
+    constexpr std::size_t perSlab = BinBlockPool::kBlocksPerSlab;
     std::vector<std::uint8_t*> blocks;
-    for (int i = 0; i < 4; ++i) {
+    for (std::size_t i = 0; i < perSlab + 3; ++i) { // a full slab and three blocks of a second
         auto* block = static_cast<std::uint8_t*>(pool.allocate());
-        EXPECT_EQ(residentPages(block), 0u) << "a fresh block costs no memory";
-        std::memset(block, 0x40 + i, kBlockBytes);
-        EXPECT_EQ(residentPages(block), kBlockBytes / 4096);
+        if (i < 4) {
+            EXPECT_EQ(residentPages(block), 0u) << "a fresh block costs no memory";
+        }
+        std::memset(block, static_cast<int>(i % 251), kBlockBytes);
         blocks.push_back(block);
     }
+    ASSERT_EQ(pool.slabCount(), 2u);
     ASSERT_EQ(blocks[1], blocks[0] + kBlockBytes); // one slab: adjacent
-    ASSERT_EQ(blocks[2], blocks[1] + kBlockBytes);
-    pool.release({blocks[1], blocks[2]}); // two adjacent blocks: one call
-    EXPECT_EQ(residentPages(blocks[1]), 0u);
-    EXPECT_EQ(residentPages(blocks[2]), 0u);
-    pool.release({blocks[3]});
-    EXPECT_EQ(residentPages(blocks[3]), 0u);
-    EXPECT_EQ(residentPages(blocks[0]), kBlockBytes / 4096);
-    for (std::size_t i = 0; i < kBlockBytes; ++i) {
-        ASSERT_EQ(blocks[0][i], 0x40);
+
+    // All of the first slab's blocks but block 5, in reverse order: nothing goes back, and
+    // every block keeps its contents.
+    std::vector<void*> firstSlab;
+    for (std::size_t i = perSlab; i-- > 0;) {
+        if (i != 5) {
+            firstSlab.push_back(blocks[i]);
+        }
+    }
+    pool.release(firstSlab);
+    EXPECT_EQ(pool.releasedSlabCount(), 0u);
+    for (std::size_t i = 0; i < perSlab; ++i) {
+        ASSERT_EQ(residentPages(blocks[i]), kBlockBytes / 4096) << "block " << i;
+        ASSERT_EQ(blocks[i][kBlockBytes - 1], i % 251);
+    }
+    // Its last block: the whole slab goes back, the second keeps its pages.
+    pool.release({blocks[5]});
+    EXPECT_EQ(pool.releasedSlabCount(), 1u);
+    for (std::size_t i = 0; i < perSlab; ++i) {
+        ASSERT_EQ(residentPages(blocks[i]), 0u) << "block " << i;
+    }
+    for (std::size_t i = perSlab; i < blocks.size(); ++i) {
+        ASSERT_EQ(residentPages(blocks[i]), kBlockBytes / 4096);
+        ASSERT_EQ(blocks[i][0], i % 251);
+    }
+    // The last slab, partly carved, goes back with the blocks carved from it.
+    pool.release({blocks[perSlab + 2], blocks[perSlab]});
+    EXPECT_EQ(pool.releasedSlabCount(), 1u);
+    EXPECT_EQ(residentPages(blocks[perSlab]), kBlockBytes / 4096);
+    pool.release({blocks[perSlab + 1]});
+    EXPECT_EQ(pool.releasedSlabCount(), 2u);
+    for (std::size_t i = perSlab; i < blocks.size(); ++i) {
+        EXPECT_EQ(residentPages(blocks[i]), 0u);
     }
 }
 
