@@ -60,12 +60,15 @@ std::size_t BinBlockPool::slabOf(const void* block) {
     return slab;
 }
 
+std::size_t BinBlockPool::carvedBlocks(std::size_t slab) const {
+    return slab + 1 == m_slabs.size() ? m_usedInLastSlab / m_blockBytes : kBlocksPerSlab;
+}
+
 void BinBlockPool::release(const std::vector<void*>& blocks) {
     m_releasedBlocks.resize(m_slabs.size(), 0);
     for (const void* block : blocks) {
         const std::size_t slab = slabOf(block);
-        const std::size_t carved =
-            slab + 1 == m_slabs.size() ? m_usedInLastSlab / m_blockBytes : kBlocksPerSlab;
+        const std::size_t carved = carvedBlocks(slab);
         assert(m_releasedBlocks[slab] < carved);
         if (++m_releasedBlocks[slab] == carved) {
             releasePages(m_slabs[slab], carved * m_blockBytes);
@@ -76,8 +79,7 @@ void BinBlockPool::release(const std::vector<void*>& blocks) {
 std::size_t BinBlockPool::releasedSlabCount() const {
     std::size_t released = 0;
     for (std::size_t slab = 0; slab < m_releasedBlocks.size(); ++slab) {
-        const std::size_t carved =
-            slab + 1 == m_slabs.size() ? m_usedInLastSlab / m_blockBytes : kBlocksPerSlab;
+        const std::size_t carved = carvedBlocks(slab);
         released += m_releasedBlocks[slab] == carved ? 1 : 0;
     }
     return released;

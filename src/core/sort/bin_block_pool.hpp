@@ -45,8 +45,9 @@ public:
 private:
     std::size_t m_blockBytes;
     std::size_t m_slabBytes;
-    // Index of the slab that holds `block`.
+    // Index of the slab that holds `block`, and how many blocks were carved from a slab.
     std::size_t slabOf(const void* block);
+    std::size_t carvedBlocks(std::size_t slab) const;
 
     std::vector<void*> m_slabs;
     std::size_t m_usedInLastSlab = 0;
