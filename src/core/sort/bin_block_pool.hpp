@@ -16,6 +16,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <map>
 #include <vector>
 
 namespace omicron {
@@ -43,16 +45,16 @@ public:
     static constexpr std::size_t kBlocksPerSlab = 1024;
 
 private:
+    struct Slab {
+        std::size_t carved = 0;   // blocks handed out
+        std::size_t released = 0; // of those, blocks given back
+    };
+
     std::size_t m_blockBytes;
     std::size_t m_slabBytes;
-    // Index of the slab that holds `block`, and how many blocks were carved from a slab.
-    std::size_t slabOf(const void* block);
-    std::size_t carvedBlocks(std::size_t slab) const;
-
-    std::vector<void*> m_slabs;
-    std::size_t m_usedInLastSlab = 0;
-    std::vector<std::size_t> m_releasedBlocks; // per slab: blocks given back
-    std::vector<std::size_t> m_slabsByAddress; // slab indices in address order
+    using Slabs = std::map<std::byte*, Slab, std::less<>>; // by address: a block's slab is found
+    Slabs m_slabs;
+    Slabs::iterator m_lastSlab = m_slabs.end(); // the one allocate() carves
 };
 
 } // namespace omicron
