@@ -10,8 +10,8 @@
 
 namespace omicron {
 
-BinBlockPool::BinBlockPool(std::size_t blockBytes)
-    : m_blockBytes(blockBytes), m_slabBytes(blockBytes * kBlocksPerSlab) {
+BinBlockPool::BinBlockPool(std::size_t blockBytes, PageSize pages)
+    : m_blockBytes(blockBytes), m_slabBytes(blockBytes * kBlocksPerSlab), m_pages(pages) {
     assert(blockBytes > 0 && blockBytes % kSmallPageBytes == 0);
 }
 
@@ -27,6 +27,9 @@ void* BinBlockPool::allocate() {
                             MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
         if (memory == MAP_FAILED) {
             throw std::bad_alloc();
+        }
+        if (m_pages == PageSize::Huge) {
+            adviseHugePages(memory, m_slabBytes);
         }
         try {
             m_lastSlab = m_slabs.emplace(static_cast<std::byte*>(memory), Slab{}).first;

@@ -14,6 +14,8 @@
 // alternating runs each), for a peak 24 MB lower.
 #pragma once
 
+#include "points/huge_page_buffer.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -24,8 +26,10 @@ namespace omicron {
 
 class BinBlockPool {
 public:
-    // Blocks of `blockBytes` each, a multiple of the small page size (asserted).
-    explicit BinBlockPool(std::size_t blockBytes);
+    // Blocks of `blockBytes` each, a multiple of the small page size (asserted). Huge: the
+    // slabs are advised huge pages where they pay off (points/huge_page_policy.hpp); a fresh
+    // block then shares its 2 MiB page with blocks already written.
+    explicit BinBlockPool(std::size_t blockBytes, PageSize pages = PageSize::Small);
     ~BinBlockPool(); // unmaps every slab: no block may be used after it
     BinBlockPool(const BinBlockPool&) = delete;
     BinBlockPool& operator=(const BinBlockPool&) = delete;
@@ -52,6 +56,7 @@ private:
 
     std::size_t m_blockBytes;
     std::size_t m_slabBytes;
+    PageSize m_pages;
     using Slabs = std::map<std::byte*, Slab, std::less<>>; // by address: a block's slab is found
     Slabs m_slabs;
     Slabs::iterator m_lastSlab = m_slabs.end(); // the one allocate() carves

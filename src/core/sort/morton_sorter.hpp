@@ -87,9 +87,9 @@ public:
     // position, one per point), as OverlappedBatchConsumer hands them over.
     void add(const PointBatch& batch, std::span<const morton::Code> codes);
 
-    // Any thread, while another calls add(): faults in the arrival-order pages of the next
-    // points whose pages no add() or earlier call has claimed, below `limit` points (a step of
-    // them at a time). Returns false when there is nothing left to claim below `limit`. The
+    // One thread besides add()'s, while that one calls add(): faults in the arrival-order pages of
+    // the next points whose pages no add() or earlier call has claimed, below `limit` points (a
+    // step of them at a time). Returns false when there is nothing left to claim below `limit`. The
     // reader thread calls it while it waits for the sorter's thread (OverlappedBatchConsumer),
     // taking over part of the page faults that otherwise make the sorter's side the longer.
     bool populateAhead(std::size_t limit);
@@ -190,11 +190,20 @@ private:
     std::size_t m_arrivalCapacity = 0; // points the arrival arrays have room for
     // Points whose arrival pages are faulted in, or claimed by a thread doing it.
     std::atomic<std::size_t> m_populated{0};
+    // While populateAhead() writes to pages: a point index at or below its step's first
+    // (kNotTouching otherwise). Sequentially consistent with m_populated's claims, so add()
+    // either sees the bound or made its claim before the step's.
+    static constexpr std::size_t kNotTouching = SIZE_MAX;
+    std::atomic<std::size_t> m_helperTouching{kNotTouching};
+    // Writes a byte to each page of the arrival arrays wholly inside the points [begin, end).
+    void touchArrival(std::size_t begin, std::size_t end) const;
+    // add()'s wait until no populateAhead() step below `end` is being written.
+    void waitForHelper(std::size_t end) const;
     void populateArrival(std::size_t begin, std::size_t end) const;
     // Claims [m_populated, end) and faults its pages in (add()'s own batch).
     void populateUpTo(std::size_t end);
     std::size_t m_pagesRecycled = 0;
-    BinBlockPool m_binBlocks{kBinBlock * sizeof(std::uint32_t)}; // outlives m_bins
+    BinBlockPool m_binBlocks{kBinBlock * sizeof(std::uint32_t), PageSize::Huge}; // outlives m_bins
     std::vector<Bin> m_bins;
     std::vector<std::uint16_t> m_blockLastBin;
     std::vector<morton::Code> m_batchCodes; // scratch for add()

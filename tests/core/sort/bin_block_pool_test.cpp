@@ -102,5 +102,27 @@ TEST(BinBlockPool, ASlabsPagesGoBackWhenItsLastBlockIsGivenBack) {
     }
 }
 
+// Slabs advised huge pages (the sorter's, where they pay off): the same contents, and a slab's
+// memory still goes back whole with its last block.
+TEST(BinBlockPool, HugePageSlabsKeepContentsAndGoBackWhole) {
+    BinBlockPool pool(kBlockBytes, PageSize::Huge);
+    constexpr std::size_t perSlab = BinBlockPool::kBlocksPerSlab;
+    std::vector<std::uint8_t*> blocks;
+    for (std::size_t i = 0; i < perSlab + 1; ++i) {
+        auto* block = static_cast<std::uint8_t*>(pool.allocate());
+        std::memset(block, static_cast<int>(i % 251), kBlockBytes);
+        blocks.push_back(block);
+    }
+    ASSERT_EQ(pool.slabCount(), 2u);
+    std::vector<void*> firstSlab(blocks.begin(), blocks.begin() + perSlab);
+    pool.release(firstSlab);
+    EXPECT_EQ(pool.releasedSlabCount(), 1u);
+    for (std::size_t i = 0; i < perSlab; ++i) {
+        ASSERT_EQ(residentPages(blocks[i]), 0u) << "block " << i;
+    }
+    EXPECT_EQ(residentPages(blocks[perSlab]), kBlockBytes / 4096);
+    EXPECT_EQ(blocks[perSlab][kBlockBytes - 1], perSlab % 251);
+}
+
 } // namespace
 } // namespace omicron
