@@ -9,6 +9,7 @@
 #include "levels_json.hpp"
 #include "pipeline/build_pipeline.hpp"
 #include "points/huge_page_buffer.hpp"
+#include "points/huge_page_policy.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -22,6 +23,11 @@
 namespace omicron::cli {
 
 namespace {
+
+// The page size the cloud's big arrays asked for (points/huge_page_policy.hpp).
+const char* pagesInUse() {
+    return hugePagesPayOff() ? "huge" : "small";
+}
 
 struct SavedFile {
     std::string path; // empty without --save
@@ -73,6 +79,7 @@ void printJson(const PipelineResult& run, const BuildOptions& options, const Sav
     json.key("sort_runs").value(static_cast<std::uint64_t>(run.sortRuns));
     json.key("bytes_resident").value(static_cast<std::uint64_t>(s.bytesResident()));
     json.key("point_storage").value(toString(s.pointStorage));
+    json.key("pages").value(pagesInUse());
     json.key("cloud_bytes").value(static_cast<std::uint64_t>(s.cloudBytes));
     json.key("hierarchy_bytes")
         .value(static_cast<std::uint64_t>(s.nodeBytes + s.sampleBytes + s.splatBytes));
@@ -138,10 +145,11 @@ void printText(const PipelineResult& run, const BuildOptions& options, const Sav
         std::printf("sort:        beyond the memory budget: %zu sorted runs on disk, merged\n",
                     run.sortRuns);
     }
-    std::printf("memory:      %.1f MiB resident (%.1f bytes per input point), %s point store\n",
+    std::printf("memory:      %.1f MiB resident (%.1f bytes per input point), %s point store on "
+                "%s pages\n",
                 s.bytesResident() / 1048576.0,
                 s.inputPoints ? double(s.bytesResident()) / double(s.inputPoints) : 0.0,
-                toString(s.pointStorage));
+                toString(s.pointStorage), pagesInUse());
     if (!saved.path.empty()) {
         std::printf("saved:       %s (%llu bytes)\n", saved.path.c_str(),
                     static_cast<unsigned long long>(saved.bytes));
@@ -233,7 +241,8 @@ const Command& buildCommand() {
         "  --json             one JSON object: points_in, levels [{level, nodes, leaves,\n"
         "                     points}], creation_s, read_s, sort_s, sort_runs (0: sorted\n"
         "                     in memory), bytes_resident\n"
-        "                     (cloud_bytes + hierarchy_bytes), point_storage,\n"
+        "                     (cloud_bytes + hierarchy_bytes), point_storage, pages (huge\n"
+        "                     or small: which the big arrays asked for, see README)\n"
         "                     milestones_s (time at 10 %, 20 %, ... of the points inserted),\n"
         "                     saved and saved_bytes with --save\n"
         "\n"

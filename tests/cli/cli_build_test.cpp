@@ -109,6 +109,24 @@ std::uint64_t jsonCount(const std::string& json, const std::string& key) {
     return std::stoull(match[1]);
 }
 
+// The JSON and the text name the page size the big arrays asked for; OMICRON_HUGE_PAGES
+// forces either.
+TEST(CliBuild, NamesThePageSizeItUsed) {
+    OMICRON_REQUIRE_SHARED_FILE(path, "autzen_trim.ply");
+    for (const std::string pages : {"huge", "small"}) {
+        const std::string force =
+            std::string("OMICRON_HUGE_PAGES=") + (pages == "huge" ? "1" : "0");
+        const auto json =
+            runProcess("/usr/bin/env", {force, OMICRON_CLI_PATH, "build", path, "--json"});
+        ASSERT_EQ(json.exitCode, 0) << json.err;
+        EXPECT_NE(json.out.find("\"pages\":\"" + pages + "\""), std::string::npos) << json.out;
+        const auto text = runProcess("/usr/bin/env", {force, OMICRON_CLI_PATH, "build", path});
+        ASSERT_EQ(text.exitCode, 0) << text.err;
+        EXPECT_NE(text.out.find("point store on " + pages + " pages"), std::string::npos)
+            << text.out;
+    }
+}
+
 // --store packed, from unsorted input and from a .oms: the same levels as exact, the cloud in
 // fewer bytes, the store named in the JSON; a bad store name is a usage error.
 TEST(CliBuild, PackedStoreBuildsTheSameLevelsInFewerBytes) {
