@@ -62,7 +62,8 @@ void* mapAnonymous(std::size_t bytes) {
                      std::strerror(errno));
         std::exit(1);
     }
-    // Small pages, as the pipeline uses them here (see README, "Huge pages").
+    // Small pages: what a fresh page costs one fault at a time (huge pages are the policy's
+    // other side, points/huge_page_policy.hpp; see README, "Huge pages").
     madvise(memory, bytes, MADV_NOHUGEPAGE);
     return memory;
 }
