@@ -300,9 +300,9 @@ bool IncrementalMortonSorter::populateAhead(std::size_t limit) {
 
 // Written from user space rather than populated with madvise: under a hypervisor that shadows
 // the guest's page tables, a page the kernel populated still costs an exit at its first user
-// access, and that fell to the sorter's copy. 512 MiB populated from another thread, then
-// copied: 0.06-0.27 s + 0.8-1.3 s; touched from another thread, then copied: 1.6 s + 0.1-0.36
-// s (bench/page_cost_bench's host). The touching thread is the reader, otherwise waiting.
+// access, and that fell to the sorter's copy. On such a 2-core VM, 512 MiB populated from
+// another thread, then copied: 0.06-0.27 s + 0.8-1.3 s; touched from another thread, then
+// copied: 1.6 s + 0.1-0.36 s. The touching thread is the reader, which would otherwise wait.
 void IncrementalMortonSorter::touchArrival(std::size_t begin, std::size_t end) const {
     for (std::size_t c = 0; c < kColumns; ++c) {
         const ArrivalColumn& column = m_arrivalColumns[c];

@@ -87,11 +87,12 @@ public:
     // position, one per point), as OverlappedBatchConsumer hands them over.
     void add(const PointBatch& batch, std::span<const morton::Code> codes);
 
-    // One thread besides add()'s, while that one calls add(): faults in the arrival-order pages of
-    // the next points whose pages no add() or earlier call has claimed, below `limit` points (a
-    // step of them at a time). Returns false when there is nothing left to claim below `limit`. The
-    // reader thread calls it while it waits for the sorter's thread (OverlappedBatchConsumer),
-    // taking over part of the page faults that otherwise make the sorter's side the longer.
+    // One thread (not add()'s), while add() runs: faults in the arrival-order pages of the
+    // next points whose pages no add() or earlier call has claimed, below `limit` points (a
+    // step of them at a time). Returns false when there is nothing left to claim below
+    // `limit`. The reader thread calls it while it waits for the sorter's thread
+    // (OverlappedBatchConsumer), taking over part of the page faults that otherwise make the
+    // sorter's side the longer.
     bool populateAhead(std::size_t limit);
 
     // Any thread, any time: a copy of the current preview sample (bounded size).
