@@ -3,8 +3,8 @@
 # and =0, alternating run by run, on a tmpfs so the disk is out of the comparison), each run
 # after an idle pause: the state a build usually starts from. It checks the choice
 # points/huge_page_policy.hpp makes for this machine (huge pages, unless free memory is
-# reported to a hypervisor and small pages measure cheaper there). Prints one line per run and a summary with the medians, the ratio
-# and what the policy picks here.
+# reported to a hypervisor and small pages measure cheaper there). Prints one line per run and
+# a summary with the medians, the ratio and what the policy picks here.
 #
 # usage: bench/huge_pages.sh CLOUD [--copies K] [--runs N] [--idle S]
 #   CLOUD    a PLY, LAS or LAZ file, tiled K times (default 1) into one LAS 1.2 file

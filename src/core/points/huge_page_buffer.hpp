@@ -122,6 +122,19 @@ inline void populatePages(const void* memory, std::size_t bytes) {
     madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
 }
 
+// Writes a byte to each small page wholly inside [memory, memory + bytes) of an anonymous
+// buffer not written yet (it reads as zero, so the zero written changes nothing): its faults,
+// taken from user space on the calling thread. Where a hypervisor shadows the guest's page
+// tables, a page populatePages() faulted in still costs an exit at its first user access; one
+// touched here does not (see IncrementalMortonSorter::populateAhead). The pages only partly
+// inside are left alone: other threads may be writing the rest of them.
+inline void touchWholePages(void* memory, std::size_t bytes) {
+    const WholePages pages = wholePages(memory, bytes, kSmallPageBytes);
+    for (std::uintptr_t page = pages.first; page < pages.last; page += kSmallPageBytes) {
+        *reinterpret_cast<volatile std::byte*>(page) = std::byte{0};
+    }
+}
+
 template <typename T> class HugePageArray {
     static_assert(std::is_trivially_copyable_v<T>, "elements are left uninitialised");
 

@@ -1,8 +1,9 @@
 #include "points/huge_page_policy.hpp"
 
+#include "points/huge_page_buffer.hpp"
+
 #include <chrono>
 #include <cstddef>
-#include <cstdint>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
@@ -14,8 +15,6 @@ namespace {
 
 constexpr const char* kPageReportingParameters = "/sys/module/page_reporting/parameters";
 constexpr const char* kTransparentHugePages = "/sys/kernel/mm/transparent_hugepage/enabled";
-constexpr std::size_t kHugeBytes = std::size_t{2} << 20;
-constexpr std::size_t kSmallBytes = 4096;
 
 // The selected mode is the bracketed word: "always [madvise] never".
 bool transparentHugePagesOff() {
@@ -28,17 +27,17 @@ bool transparentHugePagesOff() {
 // address aligned to 2 MiB so that a huge page can back each 2 MiB; infinite if nothing could
 // be mapped.
 double secondsToFirstTouch(std::size_t bytes, int advice) {
-    const std::size_t mapped = bytes + kHugeBytes;
+    const std::size_t mapped = bytes + kHugePageBytes;
     void* memory = mmap(nullptr, mapped, PROT_READ | PROT_WRITE,
                         MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
     if (memory == MAP_FAILED) {
         return std::numeric_limits<double>::infinity();
     }
-    auto* aligned = reinterpret_cast<volatile std::byte*>(
-        (reinterpret_cast<std::uintptr_t>(memory) + kHugeBytes - 1) & ~(kHugeBytes - 1));
-    madvise(const_cast<std::byte*>(aligned), bytes, advice);
+    adviseWholePages(memory, mapped, kHugePageBytes, advice);
+    auto* aligned =
+        reinterpret_cast<volatile std::byte*>(wholePages(memory, mapped, kHugePageBytes).first);
     const auto start = std::chrono::steady_clock::now();
-    for (std::size_t at = 0; at < bytes; at += kSmallBytes) {
+    for (std::size_t at = 0; at < bytes; at += kSmallPageBytes) {
         aligned[at] = std::byte{1};
     }
     const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
@@ -52,11 +51,11 @@ FirstTouchCost measureFirstTouchCost() {
     constexpr double kMiB = 1 << 20;
     FirstTouchCost cost;
     cost.smallSecondsPerMiB =
-        secondsToFirstTouch(kHugeBytes, MADV_NOHUGEPAGE) / (kHugeBytes / kMiB);
+        secondsToFirstTouch(kHugePageBytes, MADV_NOHUGEPAGE) / (kHugePageBytes / kMiB);
     cost.hugeSecondsPerMiB =
         transparentHugePagesOff()
             ? std::numeric_limits<double>::infinity()
-            : secondsToFirstTouch(2 * kHugeBytes, MADV_HUGEPAGE) / (2 * kHugeBytes / kMiB);
+            : secondsToFirstTouch(2 * kHugePageBytes, MADV_HUGEPAGE) / (2 * kHugePageBytes / kMiB);
     return cost;
 }
 

@@ -31,8 +31,8 @@ struct FirstTouchCost {
     double hugeSecondsPerMiB = 0.0;
     double smallSecondsPerMiB = 0.0;
 };
-// Maps 4 MiB on huge pages and 2 MiB on small ones, touches them and unmaps them: about 10 ms
-// where small pages are dear, 1 ms on bare metal.
+// Maps 4 MiB on huge pages and 2 MiB on small ones, touches them and unmaps them: about 6 ms
+// where small pages are dear.
 FirstTouchCost measureFirstTouchCost();
 
 // The decision itself, for tests: `override` is OMICRON_HUGE_PAGES's value (if set),

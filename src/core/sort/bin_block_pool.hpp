@@ -2,8 +2,8 @@
 //
 // The bins grow a block at a time on the thread that adds batches. From the heap, each block
 // grew that thread's malloc arena with mprotect, which takes the address space's lock for
-// writing, so it waited for every page populate the reader thread ran meanwhile
-// (MADV_POPULATE_WRITE holds that lock for reading): on autzen_south half the read phase's
+// writing, so it waited for every page populate the reader thread ran meanwhile (then
+// MADV_POPULATE_WRITE, which holds that lock for reading): on autzen_south half the read phase's
 // context switches were such waits, and the reader and the sorter ran one at a time. Here a
 // slab of 16 MiB is mapped once every 1024 blocks of 16 KiB.
 //

@@ -257,14 +257,11 @@ void IncrementalMortonSorter::appendArrival(const PointBatch& batch) {
 }
 
 void IncrementalMortonSorter::populateArrival(std::size_t begin, std::size_t end) const {
-    for (std::size_t c = 0; c < kColumns; ++c) {
-        const ArrivalColumn& column = m_arrivalColumns[c];
-        if (column.base != nullptr && column.pointBytes != 0 &&
-            !m_uniform[c].load(std::memory_order_relaxed)) {
-            populatePages(column.base + begin * column.pointBytes,
-                          (end - begin) * column.pointBytes);
-        }
-    }
+    forEachArrivalRange(begin, end, populatePages);
+}
+
+void IncrementalMortonSorter::touchArrival(std::size_t begin, std::size_t end) const {
+    forEachArrivalRange(begin, end, touchWholePages);
 }
 
 void IncrementalMortonSorter::populateUpTo(std::size_t end) {
@@ -281,10 +278,10 @@ bool IncrementalMortonSorter::populateAhead(std::size_t limit) {
     // sees the sorter take its batch.
     constexpr std::size_t kStepPoints = std::size_t{1} << 14;
     limit = std::min(limit, m_arrivalCapacity);
+    std::size_t from = m_populated.load();
     // Announced before the claim, as a bound below it, so that add() never copies into a page
     // this thread may still be touching (see waitForHelper()).
-    m_helperTouching.store(m_populated.load());
-    std::size_t from = m_populated.load();
+    m_helperTouching.store(from);
     std::size_t to = 0;
     do {
         if (from >= limit) {
@@ -293,36 +290,15 @@ bool IncrementalMortonSorter::populateAhead(std::size_t limit) {
         }
         to = std::min(limit, from + kStepPoints);
     } while (!m_populated.compare_exchange_weak(from, to));
+    // Written from user space rather than populated with madvise: under a hypervisor that
+    // shadows the guest's page tables, a page the kernel populated still costs an exit at its
+    // first user access, and that fell to the sorter's copy. On such a 2-core VM, 512 MiB
+    // populated from another thread, then copied: 0.06-0.27 s + 0.8-1.3 s; touched from another
+    // thread, then copied: 1.6 s + 0.1-0.36 s. This thread is the reader, which would otherwise
+    // wait.
     touchArrival(from, to);
     m_helperTouching.store(kNotTouching, std::memory_order_release);
     return true;
-}
-
-// Written from user space rather than populated with madvise: under a hypervisor that shadows
-// the guest's page tables, a page the kernel populated still costs an exit at its first user
-// access, and that fell to the sorter's copy. On such a 2-core VM, 512 MiB populated from
-// another thread, then copied: 0.06-0.27 s + 0.8-1.3 s; touched from another thread, then
-// copied: 1.6 s + 0.1-0.36 s. The touching thread is the reader, which would otherwise wait.
-void IncrementalMortonSorter::touchArrival(std::size_t begin, std::size_t end) const {
-    for (std::size_t c = 0; c < kColumns; ++c) {
-        const ArrivalColumn& column = m_arrivalColumns[c];
-        if (column.base == nullptr || column.pointBytes == 0 ||
-            m_uniform[c].load(std::memory_order_relaxed)) {
-            continue;
-        }
-        // Only the pages wholly inside [begin, end): the others hold points add() may be
-        // copying meanwhile. A page left out is faulted in by the copy.
-        const auto address = [&](std::size_t point) {
-            return reinterpret_cast<std::uintptr_t>(column.base + point * column.pointBytes);
-        };
-        const std::uintptr_t first =
-            (address(begin) + kSmallPageBytes - 1) & ~(kSmallPageBytes - 1);
-        const std::uintptr_t last = address(end) & ~(kSmallPageBytes - 1);
-        for (std::uintptr_t page = first; page < last; page += kSmallPageBytes) {
-            // Unwritten arrival memory: it reads as zero, so writing zero changes nothing.
-            *reinterpret_cast<volatile std::byte*>(page) = std::byte{0};
-        }
-    }
 }
 
 void IncrementalMortonSorter::waitForHelper(std::size_t end) const {

@@ -196,11 +196,24 @@ private:
     // either sees the bound or made its claim before the step's.
     static constexpr std::size_t kNotTouching = SIZE_MAX;
     std::atomic<std::size_t> m_helperTouching{kNotTouching};
-    // Writes a byte to each page of the arrival arrays wholly inside the points [begin, end).
-    void touchArrival(std::size_t begin, std::size_t end) const;
     // add()'s wait until no populateAhead() step below `end` is being written.
     void waitForHelper(std::size_t end) const;
+    // Calls f(bytes, size) with the bytes of the points [begin, end) in each arrival array
+    // that is stored (not uniform).
+    template <typename F>
+    void forEachArrivalRange(std::size_t begin, std::size_t end, F&& f) const {
+        for (std::size_t c = 0; c < kColumns; ++c) {
+            const ArrivalColumn& column = m_arrivalColumns[c];
+            if (column.base != nullptr && column.pointBytes != 0 &&
+                !m_uniform[c].load(std::memory_order_relaxed)) {
+                f(column.base + begin * column.pointBytes, (end - begin) * column.pointBytes);
+            }
+        }
+    }
+    // Faults in the arrival pages of the points [begin, end) with one call per array.
     void populateArrival(std::size_t begin, std::size_t end) const;
+    // The same from user space, only the pages wholly inside (touchWholePages).
+    void touchArrival(std::size_t begin, std::size_t end) const;
     // Claims [m_populated, end) and faults its pages in (add()'s own batch).
     void populateUpTo(std::size_t end);
     std::size_t m_pagesRecycled = 0;
