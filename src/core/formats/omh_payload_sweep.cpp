@@ -2,6 +2,7 @@
 
 #include "formats/background_job.hpp"
 #include "formats/omh_record_sink.hpp"
+#include "io/scratch_bytes.hpp"
 
 #include <algorithm>
 #include <array>
@@ -83,9 +84,7 @@ public:
 private:
     void encode(std::size_t i) {
         const Block& block = m_blocks[i];
-        std::vector<std::uint8_t>& bytes = m_buffers[i % kTokens];
-        bytes.resize(block.records * m_layout.bytes);
-        std::uint8_t* out = bytes.data();
+        std::uint8_t* out = m_buffers[i % kTokens].take(block.records * m_layout.bytes).data();
         for (const Piece& piece : block.pieces) {
             encodeOmhRecords(m_cloud, m_layout, *piece.node, *piece.splats, piece.first, piece.last,
                              out);
@@ -96,7 +95,8 @@ private:
 
     // Hashes and writes block i through its level's sink (the pipeline's serial stage).
     void write(std::size_t i) {
-        const std::vector<std::uint8_t>& bytes = m_buffers[i % kTokens];
+        const std::span<std::uint8_t> bytes =
+            m_buffers[i % kTokens].take(m_blocks[i].records * m_layout.bytes);
         m_sinks[static_cast<std::size_t>(m_blocks[i].level - m_firstLevel)].addEncoded(
             bytes.data(), bytes.size());
     }
@@ -120,7 +120,9 @@ private:
     int m_firstLevel;
     std::size_t m_blockRecords;
     std::vector<Block> m_blocks; // the batch's, in file order per level
-    std::array<std::vector<std::uint8_t>, kTokens> m_buffers;
+    // Never zeroed: a block is encoded whole before it is written (resizing a vector zeroed
+    // what it grew by, 35 ms of a 24.2 M-point save).
+    std::array<ScratchBytes, kTokens> m_buffers;
 };
 
 } // namespace

@@ -158,13 +158,14 @@ void encodeOmhRecords(const SortedCloud& cloud, const omh::RecordLayout& layout,
 
 void OmhRecordSink::add(std::uint32_t index, std::uint16_t encodedRadius,
                         std::uint32_t estimatedNormal) {
-    if (m_used == m_block.size()) {
+    if (m_used == m_blockBytes) {
         flush();
-        if (m_block.empty()) { // first use: a sink fed only encoded blocks never needs it
-            m_block.resize(std::max<std::size_t>(1, kBlockBytes / m_layout.bytes) * m_layout.bytes);
+        if (m_blockBytes == 0) { // first use: a sink fed only encoded blocks never needs it
+            m_blockBytes = std::max<std::size_t>(1, kBlockBytes / m_layout.bytes) * m_layout.bytes;
         }
     }
-    encodeRecord(m_cloud, m_layout, index, encodedRadius, estimatedNormal, m_block.data() + m_used);
+    encodeRecord(m_cloud, m_layout, index, encodedRadius, estimatedNormal,
+                 m_block.take(m_blockBytes).data() + m_used);
     m_used += m_layout.bytes;
 }
 
@@ -211,7 +212,7 @@ std::uint64_t OmhRecordSink::finishSection() {
 }
 
 void OmhRecordSink::flush() {
-    write(m_block.data(), m_used);
+    write(m_block.take(m_used).data(), m_used);
     m_used = 0;
 }
 

@@ -9,6 +9,7 @@
 #include "formats/omh_format.hpp"
 #include "formats/oms_format.hpp"
 #include "io/atomic_file_writer.hpp"
+#include "io/scratch_bytes.hpp"
 #include "io/write_behind.hpp"
 #include "points/sorted_cloud.hpp"
 
@@ -61,7 +62,9 @@ private:
     AtomicFileWriter& m_file;
     const SortedCloud& m_cloud;
     omh::RecordLayout m_layout;
-    std::vector<std::uint8_t> m_block;
+    ScratchBytes m_block; // m_blockBytes once used, never zeroed: a top level's few records
+                          // fault in only their own pages
+    std::size_t m_blockBytes = 0;
     std::size_t m_used = 0;
     std::vector<std::uint8_t> m_sparseSplats; // version 3: written at the section's end
     std::unique_ptr<oms::PayloadChecksum> m_checksum;

@@ -37,8 +37,7 @@ std::optional<std::uint64_t> tmpfsFreeBytes(int fd) {
 }
 } // namespace
 
-AtomicFileWriter::AtomicFileWriter(std::string targetPath)
-    : m_targetPath(std::move(targetPath)), m_buffer(kBufferBytes) {
+AtomicFileWriter::AtomicFileWriter(std::string targetPath) : m_targetPath(std::move(targetPath)) {
     const std::filesystem::path target(m_targetPath);
     if (std::filesystem::is_directory(target)) {
         throw OutputError(m_targetPath + ": is a directory, expected a file name to write");
@@ -81,6 +80,7 @@ AtomicFileWriter::AtomicFileWriter(std::string targetPath)
 }
 
 AtomicFileWriter::~AtomicFileWriter() {
+    stopFlushing();
     if (m_fd >= 0) {
         ::close(m_fd);
     }
@@ -95,8 +95,9 @@ void AtomicFileWriter::fail(const std::string& what, int error) {
 
 void AtomicFileWriter::flushBuffer() {
     std::size_t done = 0;
+    const std::uint8_t* buffer = m_buffer.take(m_buffered).data();
     while (done < m_buffered) {
-        const ssize_t wrote = ::write(m_fd, m_buffer.data() + done, m_buffered - done);
+        const ssize_t wrote = ::write(m_fd, buffer + done, m_buffered - done);
         if (wrote < 0) {
             if (errno == EINTR) {
                 continue;
@@ -114,13 +115,14 @@ void AtomicFileWriter::write(const void* data, std::size_t count) {
     const auto* bytes = static_cast<const char*>(data);
     m_bytesWritten += count;
     while (count > 0) {
-        const std::size_t room = m_buffer.size() - m_buffered;
+        std::uint8_t* buffer = m_buffer.take(kBufferBytes).data();
+        const std::size_t room = kBufferBytes - m_buffered;
         const std::size_t take = count < room ? count : room;
-        std::memcpy(m_buffer.data() + m_buffered, bytes, take);
+        std::memcpy(buffer + m_buffered, bytes, take);
         m_buffered += take;
         bytes += take;
         count -= take;
-        if (m_buffered == m_buffer.size()) {
+        if (m_buffered == kBufferBytes) {
             flushBuffer();
         }
     }
@@ -185,6 +187,53 @@ void AtomicFileWriter::extendTo(std::uint64_t size) {
 void AtomicFileWriter::startWriteBack(std::uint64_t offset, std::uint64_t count) {
     sync_file_range(m_fd, static_cast<off_t>(offset), static_cast<off_t>(count),
                     SYNC_FILE_RANGE_WRITE);
+    requestFlush();
+}
+
+void AtomicFileWriter::requestFlush() {
+    const std::lock_guard lock(m_flushMutex);
+    m_flushRequested = true;
+    if (!m_flusher.joinable() && !m_flushStop) { // started with the first window written back
+        m_flusher = std::thread([this] { flushLoop(); });
+    }
+    m_flushWake.notify_one();
+}
+
+void AtomicFileWriter::flushLoop() {
+    std::unique_lock lock(m_flushMutex);
+    while (true) {
+        m_flushWake.wait(lock, [this] { return m_flushRequested || m_flushStop; });
+        if (m_flushStop) {
+            return; // commit()'s fsync persists the rest
+        }
+        m_flushRequested = false;
+        lock.unlock();
+        // The data only: the file's size and blocks were set when it was extended, and its
+        // times are commit()'s fsync's.
+        const int error = ::fdatasync(m_fd) == 0 ? 0 : errno;
+        lock.lock();
+        ++m_flushes;
+        if (error != 0 && m_flushError == 0) {
+            m_flushError = error; // reported once per descriptor: commit() must see it here
+        }
+    }
+}
+
+int AtomicFileWriter::stopFlushing() {
+    {
+        const std::lock_guard lock(m_flushMutex);
+        m_flushStop = true;
+    }
+    m_flushWake.notify_one();
+    if (m_flusher.joinable()) {
+        m_flusher.join();
+    }
+    return m_flushError;
+}
+
+std::uint64_t AtomicFileWriter::backgroundFlushes() const {
+    const std::lock_guard lock(m_flushMutex);
+    return m_flushes;
 }
 
 void AtomicFileWriter::dropFromCache(std::uint64_t offset, std::uint64_t count) {
@@ -215,6 +264,9 @@ void AtomicFileWriter::nameTemporary() {
 
 void AtomicFileWriter::commit() {
     flushBuffer();
+    if (const int error = stopFlushing(); error != 0) {
+        fail("fsync failed", error);
+    }
     if (::fsync(m_fd) != 0) {
         fail("fsync failed", errno);
     }

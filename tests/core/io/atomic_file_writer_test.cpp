@@ -1,12 +1,14 @@
 // AtomicFileWriter::extendTo: the region a save fills out of order (the .omh's deep levels)
-// is reserved on a disk and only checked on a tmpfs, where reserving means zeroing memory; and
-// the temporaries a killed writer left are removed by the next writer of the same target.
+// is reserved on a disk and only checked on a tmpfs, where reserving means zeroing memory; a
+// big file is persisted while it is written; and the temporaries a killed writer left are
+// removed by the next writer of the same target.
 #include "io/atomic_file_writer.hpp"
 #include "io/leftover_files.hpp"
 #include "run_process.hpp"
 #include "test_files.hpp"
 
 #include <cerrno>
+#include <chrono>
 #include <csignal>
 #include <cstdint>
 #include <filesystem>
@@ -18,6 +20,7 @@
 #include <sys/statvfs.h>
 #include <sys/vfs.h>
 #include <sys/wait.h>
+#include <thread>
 #include <unistd.h>
 #include <vector>
 
@@ -141,6 +144,55 @@ TEST(AtomicFileWriterExtend, OnATmpfsWithoutTheRoomItIsAClearErrorAndNothingIsLe
             << message;
     }
     EXPECT_EQ(entriesIn(dir.path()), 0u) << "the temporary file was left behind";
+}
+
+// A file of `mebibytes` MiB, each MiB a different byte, written in 1 MiB appends.
+std::vector<char> writeMebibytes(AtomicFileWriter& file, std::size_t mebibytes) {
+    std::vector<char> expected;
+    for (std::size_t m = 0; m < mebibytes; ++m) {
+        const std::vector<char> piece(std::size_t{1} << 20, static_cast<char>('A' + m % 26));
+        file.write(piece.data(), piece.size());
+        expected.insert(expected.end(), piece.begin(), piece.end());
+    }
+    return expected;
+}
+
+// A big file is persisted while it is written (each 16 MiB window written back wakes the
+// writer's flushing thread), and the committed file is exactly what was written.
+TEST(AtomicFileWriterFlush, ABigFileIsPersistedWhileWrittenAndCommitsTheSameBytes) {
+    test::TempDir dir;
+    const std::string path = dir.file("big.bin");
+    AtomicFileWriter file(path);
+    const std::vector<char> expected = writeMebibytes(file, 40);
+    // The thread runs on its own: wait for its first flush (a liveness bound, not a timing).
+    for (int wait = 0; wait < 3000 && file.backgroundFlushes() == 0; ++wait) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    EXPECT_GT(file.backgroundFlushes(), 0u) << "40 MiB were written and nothing was persisted";
+    file.commit();
+    EXPECT_EQ(contentsOf(path), expected);
+    EXPECT_EQ(entriesIn(dir.path()), 1u) << "the temporary file was left behind";
+}
+
+// A small file (no window written back) starts no thread: commit's fsync alone persists it.
+TEST(AtomicFileWriterFlush, ASmallFileIsPersistedByTheCommitAlone) {
+    test::TempDir dir;
+    AtomicFileWriter file(dir.file("small.bin"));
+    const std::vector<char> expected = writeMebibytes(file, 3);
+    file.commit();
+    EXPECT_EQ(file.backgroundFlushes(), 0u);
+    EXPECT_EQ(contentsOf(dir.file("small.bin")), expected);
+}
+
+// A writer abandoned while its thread may be flushing (an error half-way through a save)
+// stops the thread and leaves nothing behind; the target is not created.
+TEST(AtomicFileWriterFlush, AnAbandonedWriterStopsFlushingAndLeavesNothing) {
+    test::TempDir dir;
+    {
+        AtomicFileWriter file(dir.file("abandoned.bin"));
+        writeMebibytes(file, 40);
+    }
+    EXPECT_EQ(entriesIn(dir.path()), 0u);
 }
 
 // A PID whose process has ended (a child that exited and was reaped), or 0 where that PID was
