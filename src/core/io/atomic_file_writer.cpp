@@ -17,6 +17,7 @@
 #include <string>
 #include <sys/stat.h>
 #include <sys/vfs.h>
+#include <system_error>
 #include <unistd.h>
 
 namespace omicron {
@@ -194,7 +195,11 @@ void AtomicFileWriter::requestFlush() {
     const std::lock_guard lock(m_flushMutex);
     m_flushRequested = true;
     if (!m_flusher.joinable() && !m_flushStop) { // started with the first window written back
-        m_flusher = std::thread([this] { flushLoop(); });
+        try {
+            m_flusher = std::thread([this] { flushLoop(); });
+        } catch (const std::system_error&) {
+            m_flushStop = true; // no thread to spare: commit()'s fsync persists it all, as before
+        }
     }
     m_flushWake.notify_one();
 }
