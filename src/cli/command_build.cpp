@@ -5,6 +5,7 @@
 #include "commands.hpp"
 #include "formats/omh_writer.hpp"
 #include "interrupt.hpp"
+#include "io/atomic_file_writer.hpp"
 #include "json_writer.hpp"
 #include "levels_json.hpp"
 #include "pipeline/build_pipeline.hpp"
@@ -16,6 +17,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <thread>
@@ -180,6 +182,12 @@ int runBuild(const std::vector<std::string>& args) {
     }
     const OmhWriteOptions writeOptions = saveOptions(parsed); // a bad version before the build
     const MemoryOptions memory = memoryOptions(parsed, parsed.value("save").value_or(""));
+    // The save's temporary file is made now: a target that cannot be written fails before the
+    // build, not after it (an hour, for a billion points).
+    std::optional<AtomicFileWriter> saveFile;
+    if (const auto savePath = parsed.value("save")) {
+        saveFile.emplace(*savePath);
+    }
     BuildPipeline pipeline;
     const PipelineResult run = runInterruptibly(pipeline, path,
                                                 {options, build.sortChunks, build.storage,
@@ -187,7 +195,7 @@ int runBuild(const std::vector<std::string>& args) {
                                                  /*preview=*/false});
     SavedFile saved;
     if (const auto savePath = parsed.value("save")) { // the finished hierarchy, pipeline 3's input
-        writeOmh(*savePath, *pipeline.hierarchy(), omhBuildInfo(options, run.stats), writeOptions);
+        writeOmh(*saveFile, *pipeline.hierarchy(), omhBuildInfo(options, run.stats), writeOptions);
         saved = {*savePath, std::filesystem::file_size(*savePath)};
     }
     if (parsed.flag("json")) {
@@ -227,7 +235,9 @@ const Command& buildCommand() {
         "                     per 64 points: about half the memory)\n"
         "  --save OUT.omh     save the finished hierarchy as a .omh file (written to a\n"
         "                     temporary file and renamed: an interrupted save leaves OUT as\n"
-        "                     it was); 'info OUT.omh' prints the same per-level counts\n"
+        "                     it was; the temporary is made before the build, so a target\n"
+        "                     that cannot be written fails at once); 'info OUT.omh' prints\n"
+        "                     the same per-level counts\n"
         "  --save-version V   the .omh format version: 3 (default: splat attributes estimated\n"
         "                     again when drawn, stored only for nodes of fewer than 8 points)\n"
         "                     or 2 (stored for every point, 6 bytes more a point without\n"

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <tbb/global_control.h>
 #include <thread>
 
@@ -114,6 +115,9 @@ int runExportPotree(const std::vector<std::string>& args) {
     }
     const std::string& inPath = parsed.positionals[0];
     const std::string& folder = parsed.positionals[1];
+    // The target is checked and its temporary folder made before the work: a folder that may
+    // not be replaced fails now, not after a build.
+    const std::unique_ptr<AtomicFolder> target = openPotreeExportFolder(folder);
     const Source source = isOmhFile(inPath) ? loadSavedHierarchy(inPath, parsed)
                                             : buildHierarchy(inPath, parsed, folder);
 
@@ -132,7 +136,7 @@ int runExportPotree(const std::vector<std::string>& args) {
     };
     PotreeExportSummary summary;
     try {
-        summary = exportPotree(*source.hierarchy, folder, options);
+        summary = exportPotree(*source.hierarchy, *target, options);
     } catch (const PotreeExportCancelled&) {
         progress.finish();
         throw Interrupted();
@@ -168,7 +172,8 @@ const Command& exportPotreeCommand() {
         "\n"
         "The folder is written under a temporary name beside DIR and renamed into place when\n"
         "complete: an error or Ctrl+C leaves DIR as it was. An existing DIR is replaced only\n"
-        "when it is empty or holds nothing but a Potree export.\n"
+        "when it is empty or holds nothing but a Potree export; that is checked (and the\n"
+        "temporary folder made) before the input is read, so a refusal costs no build.\n"
         "\n"
         "  --json             one JSON object: folder, points, input_points, dropped_points,\n"
         "                     nodes, chunks, depth, octree_bytes, position_tolerance (how far\n"

@@ -7,6 +7,7 @@
 #include "test_files.hpp"
 
 #include <algorithm>
+#include <filesystem>
 #include <gtest/gtest.h>
 
 namespace omicron {
@@ -98,6 +99,31 @@ TEST(CliBuild, PaperCollapseCountsDroppedPointsAndBadOptionsExitTwo) {
     EXPECT_EQ(runProcess(OMICRON_CLI_PATH, {"build", path, "--collapse", "maybe"}).exitCode, 2);
     EXPECT_EQ(runProcess(OMICRON_CLI_PATH, {"build", path, "--depth", "22"}).exitCode, 2);
     EXPECT_EQ(runProcess(OMICRON_CLI_PATH, {"build", path, "--ratio", "1.5"}).exitCode, 2);
+}
+
+// The save's target is checked before the input is read: a target that cannot be written
+// fails at once rather than after the build (the input here is damaged, and the error is the
+// target's), and nothing is left behind.
+TEST(CliBuild, AnUnwritableSaveTargetFailsBeforeTheInputIsRead) {
+    test::TempDir dir;
+    const std::string bad = dir.file("bad.ply");
+    test::writeText(bad,
+                    "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nend_header\n1\n");
+    const std::string target = dir.file("no-such-folder/out.omh");
+    const auto unwritable = runProcess(OMICRON_CLI_PATH, {"build", bad, "--save", target});
+    EXPECT_EQ(unwritable.exitCode, 1);
+    EXPECT_NE(unwritable.err.find(target + ": cannot create a temporary file"), std::string::npos)
+        << unwritable.err;
+    EXPECT_EQ(unwritable.err.find("bad.ply"), std::string::npos) << unwritable.err;
+    // With a target that can be written, the same input is what fails.
+    const auto writable =
+        runProcess(OMICRON_CLI_PATH, {"build", bad, "--save", dir.file("out.omh")});
+    EXPECT_EQ(writable.exitCode, 1);
+    EXPECT_NE(writable.err.find("bad.ply"), std::string::npos) << writable.err;
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()),
+                            std::filesystem::directory_iterator()),
+              1)
+        << "only bad.ply should be there";
 }
 
 std::uint64_t jsonCount(const std::string& json, const std::string& key) {

@@ -128,6 +128,27 @@ TEST(CliExportPotree, ErrorsNameTheFileAndWhatIsWrong) {
     EXPECT_TRUE(std::filesystem::exists(dir.file("mine/notes.txt")));
 }
 
+// The target folder is checked before the input is read: one that may not be replaced fails
+// at once rather than after the build (the input here is damaged, and the error is the
+// folder's), and the folder and its parent are as they were.
+TEST(CliExportPotree, AFolderThatMayNotBeReplacedFailsBeforeTheInputIsRead) {
+    test::TempDir dir;
+    const std::string bad = dir.file("bad.ply");
+    test::writeText(bad,
+                    "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nend_header\n1\n");
+    std::filesystem::create_directories(dir.file("mine"));
+    test::writeText(dir.file("mine/notes.txt"), "keep");
+    const auto occupied = runProcess(OMICRON_CLI_PATH, {"export-potree", bad, dir.file("mine")});
+    EXPECT_EQ(occupied.exitCode, 1);
+    EXPECT_NE(occupied.err.find("it holds 'notes.txt'"), std::string::npos) << occupied.err;
+    EXPECT_EQ(occupied.err.find("bad.ply"), std::string::npos) << occupied.err;
+    EXPECT_EQ(test::readBytes(dir.file("mine/notes.txt")).size(), 4u);
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()),
+                            std::filesystem::directory_iterator()),
+              2)
+        << "bad.ply and mine only";
+}
+
 // What an export run with OMICRON_TEST_PAUSE_POTREE_EXPORT=1 printed to `errPath` once it
 // paused (the first node written to the temporary folder), or after 60 s without a pause.
 std::string waitForPause(const std::string& errPath) {

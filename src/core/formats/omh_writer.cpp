@@ -131,13 +131,12 @@ omh::BuildInfo omhBuildInfo(const BuildOptions& options, const BuildStatistics& 
 
 namespace {
 
-// Copies the .omh a paged hierarchy reads its points from to `path` (temporary file, then
-// rename: a failure leaves the old target untouched). The source is read through its own
-// descriptor, so copying a file onto itself replaces it while the pager keeps reading the
-// old one.
-void copyPagedSource(const std::string& path, const std::string& source) {
+// Copies the .omh a paged hierarchy reads its points from into `out` and commits it (a
+// temporary file, then rename: a failure leaves the old target untouched). The source is read
+// through its own descriptor, so copying a file onto itself replaces it while the pager keeps
+// reading the old one.
+void copyPagedSource(AtomicFileWriter& out, const std::string& source) {
     FileStream in(source);
-    AtomicFileWriter out(path);
     std::vector<std::uint8_t> buffer(std::size_t{4} << 20);
     const std::uint64_t size = in.size();
     for (std::uint64_t done = 0; done < size;) {
@@ -190,8 +189,14 @@ void writeTopLevelsFromCopy(AtomicFileWriter& file, const Hierarchy& hierarchy,
 
 void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::BuildInfo& build,
               const OmhWriteOptions& options) {
+    AtomicFileWriter file(path);
+    writeOmh(file, hierarchy, build, options);
+}
+
+void writeOmh(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::BuildInfo& build,
+              const OmhWriteOptions& options) {
     const auto fail = [&](const std::string& what) {
-        throw OutputError(path + ": " + what);
+        throw OutputError(file.targetPath() + ": " + what);
     };
     if (!hierarchy.publishedCut().complete) {
         fail("the hierarchy is not complete; only a finished build can be saved");
@@ -203,7 +208,7 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
     if (const NodeResidency* paged = hierarchy.residency()) {
         // Its points were never all in memory: they are in the .omh it was opened from, and
         // loading a .omh and saving it again gives the same bytes, so the file is the save.
-        copyPagedSource(path, paged->backingFile());
+        copyPagedSource(file, paged->backingFile());
         return;
     }
     const SortedCloud& cloud = hierarchy.cloud();
@@ -260,7 +265,6 @@ void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::Bu
         payloadOffset += header.payloadBytes(entry);
     }
 
-    AtomicFileWriter file(path);
     const auto headerBytes = omh::encodeHeader(header);
     file.write(headerBytes.data(), headerBytes.size());
     // The level table holds the sections' checksums, known once they are written: it is

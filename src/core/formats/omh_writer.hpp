@@ -45,5 +45,9 @@ omh::BuildInfo omhBuildInfo(const BuildOptions& options, const BuildStatistics& 
 // afterLevel is not called); an unreadable source is an InputError naming it.
 void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::BuildInfo& build,
               const OmhWriteOptions& options = {});
+// The same into `file`, opened before the hierarchy was built (a target that cannot be written
+// fails before any work), which it commits.
+void writeOmh(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::BuildInfo& build,
+              const OmhWriteOptions& options = {});
 
 } // namespace omicron

@@ -101,8 +101,19 @@ std::string metadataJson(const PotreeExportOptions& options, const PotreeExportS
 
 } // namespace
 
+std::unique_ptr<AtomicFolder> openPotreeExportFolder(const std::string& folder) {
+    return std::make_unique<AtomicFolder>(folder, refuseUnlessPotreeExport);
+}
+
 PotreeExportSummary exportPotree(const Hierarchy& hierarchy, const std::string& folder,
                                  const PotreeExportOptions& options) {
+    const std::unique_ptr<AtomicFolder> target = openPotreeExportFolder(folder);
+    return exportPotree(hierarchy, *target, options);
+}
+
+PotreeExportSummary exportPotree(const Hierarchy& hierarchy, AtomicFolder& target,
+                                 const PotreeExportOptions& options) {
+    const std::string& folder = target.targetPath();
     if (!hierarchy.publishedCut().complete || hierarchy.nodeCount(0) != 1) {
         throw OutputError(folder + ": only a complete hierarchy can be exported");
     }
@@ -115,7 +126,6 @@ PotreeExportSummary exportPotree(const Hierarchy& hierarchy, const std::string& 
     if (options.stepSize < 1) {
         throw OutputError(folder + ": the hierarchy step size must be at least 1");
     }
-    AtomicFolder target(folder, refuseUnlessPotreeExport);
     const SortedCloud& cloud = hierarchy.cloud();
     const CubeTransform& cube = cloud.cube();
     const Geometry geometry{{cube.origin.x + cloud.sourceOffset().x,

@@ -24,10 +24,12 @@
 #include "build/hierarchy.hpp"
 #include "formats/potree_attributes.hpp"
 #include "io/atomic_file_writer.hpp"
+#include "io/atomic_folder.hpp"
 
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -75,6 +77,14 @@ public:
 // folder (an incomplete or paged hierarchy, a hierarchy whose parents are not samples of their
 // children, a folder that may not be replaced, a write error) or PotreeExportCancelled.
 PotreeExportSummary exportPotree(const Hierarchy& hierarchy, const std::string& folder,
+                                 const PotreeExportOptions& options = {});
+
+// The export's target, opened before the hierarchy is built, so that a folder that may not be
+// replaced, or beside which nothing can be written, fails before any work: a temporary folder
+// beside it (removed unless an export commits it). Throws OutputError naming the folder.
+std::unique_ptr<AtomicFolder> openPotreeExportFolder(const std::string& folder);
+// The same export into `target` (from openPotreeExportFolder), which it commits.
+PotreeExportSummary exportPotree(const Hierarchy& hierarchy, AtomicFolder& target,
                                  const PotreeExportOptions& options = {});
 
 } // namespace omicron
