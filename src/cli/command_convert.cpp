@@ -8,6 +8,7 @@
 #include "io/ply/ply_writer.hpp"
 #include "io/point_reader.hpp"
 #include "io/xyz/xyz_writer.hpp"
+#include "output_check.hpp"
 #include "sort_to_oms.hpp"
 
 #include <algorithm>
@@ -92,6 +93,7 @@ int runConvert(const std::vector<std::string>& args) {
     if (extension != ".ply" && extension != ".las" && extension != ".xyz" && extension != ".txt") {
         throw UsageError("OUT must end in .ply, .las, .xyz, .txt or .oms, found '" + outPath + "'");
     }
+    checkOutputWritable(outPath);
     const WholeCloud whole = readWhole(inPath);
     if (extension == ".ply") {
         PlyWriteOptions options;

@@ -4,6 +4,7 @@
 #include "commands.hpp"
 #include "formats/oms_reader.hpp"
 #include "io/ply/ply_writer.hpp"
+#include "output_check.hpp"
 
 #include <cstdio>
 
@@ -23,6 +24,7 @@ int runExport(const std::vector<std::string>& args) {
     }
     const std::string& inPath = parsed.positionals[0];
     const std::string& outPath = parsed.positionals[1];
+    checkOutputWritable(outPath);
     OmsReader reader(inPath);
     const ReadSummary summary = reader.read([](const SortedCloud&, std::size_t, std::size_t) {});
     const auto cloud = reader.cloud();

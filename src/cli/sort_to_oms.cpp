@@ -4,6 +4,7 @@
 #include "interrupt.hpp"
 #include "io/input_error.hpp"
 #include "io/point_reader.hpp"
+#include "output_check.hpp"
 #include "progress_line.hpp"
 
 #include <chrono>
@@ -16,6 +17,7 @@ SortToOmsResult sortToOms(const std::string& inPath, const std::string& outPath,
     const auto seconds = [](Clock::time_point since) {
         return std::chrono::duration<double>(Clock::now() - since).count();
     };
+    checkOutputWritable(outPath); // before the input is read, not after the sort
     const std::atomic<bool>& interrupted = watchInterrupts();
     options.cancel = &interrupted;
     OpenOptions openOptions;

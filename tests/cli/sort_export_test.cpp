@@ -10,6 +10,8 @@
 #include <cstring>
 #include <filesystem>
 #include <gtest/gtest.h>
+#include <string>
+#include <vector>
 
 namespace omicron {
 namespace {
@@ -155,6 +157,30 @@ TEST(CliSort, BadInputFailsWithExitOneAndLeavesNoOutput) {
     EXPECT_FALSE(std::filesystem::exists(oms));
     EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 1)
         << "a temporary file was left behind";
+}
+
+// sort, convert and export read their whole input before they write: an output that cannot
+// be written is checked first and fails at once (the input here is broken too, and the error
+// is the output's), leaving nothing behind.
+TEST(CliSort, AnUnwritableOutputFailsBeforeTheInputIsRead) {
+    test::TempDir dir;
+    const std::string broken = dir.file("broken.ply");
+    test::writeText(broken, "ply\nformat binary_little_endian 1.0\nelement vertex 10\n"
+                            "property float x\nproperty float y\nproperty float z\nend_header\n");
+    const std::string missing = dir.file("no-such-folder");
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"sort", broken, missing + "/out.oms"},
+          std::vector<std::string>{"convert", broken, missing + "/out.oms"},
+          std::vector<std::string>{"convert", broken, missing + "/out.las"},
+          std::vector<std::string>{"export", broken, missing + "/out.ply"}}) {
+        const auto result = runProcess(OMICRON_CLI_PATH, args);
+        EXPECT_EQ(result.exitCode, 1) << args[0] << " " << args[2];
+        EXPECT_NE(result.err.find(args[2] + ": cannot create a temporary file"), std::string::npos)
+            << result.err;
+        EXPECT_EQ(result.err.find(broken), std::string::npos) << result.err;
+    }
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 1)
+        << "something was left behind";
 }
 
 TEST(CliSort, UsageErrorsExitTwo) {
