@@ -451,7 +451,12 @@ TEST_P(FrontConcurrency, InvariantsHoldAndSettledLeavesAreSubstitutedWhileBuildi
     }
     EXPECT_GT(evaluationsDuringBuild, 5u) << "the front never evaluated while building";
     EXPECT_GT(substituted, 0u);
-    EXPECT_GT(readySince.size(), 0u);
+    // Usually the test sees leaves wait, and checked their bound above. Under load (a parallel
+    // ctest on two cores) it may see none: the builder then published only while the front
+    // was evaluating, which substituted each leaf in the evaluation it became ready in, and
+    // the front's own record must say so.
+    EXPECT_TRUE(readySince.size() > 0 || worstSweeps == 0)
+        << "no leaf was seen waiting, yet one waited " << worstSweeps << " evaluations";
     EXPECT_EQ(front.takeSubstitutionDelays().size(), 0u) << "taken above: must be cleared";
     std::printf("  %llu evaluations (%llu during the build), %llu substituted, worst %llu "
                 "evaluations ready -> substituted, %llu finished sweeps while waiting\n",
