@@ -27,6 +27,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace omicron {
@@ -96,6 +97,9 @@ private:
     std::uint64_t m_bytesWritten = 0;
     std::uint64_t m_onFile = 0;      // bytes handed to write(2)
     WriteBehind m_writeBehind;       // large files: written windows leave the page cache
+    // The ranges dropFromCache() was asked to drop, merged where they meet (one per region
+    // written front to back), dropped again by commit() once the file is persisted.
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> m_dropped;
     bool m_committed = false;
     // The persisting thread and what it shares with the writers, under m_flushMutex.
     std::thread m_flusher;
