@@ -145,11 +145,17 @@ TEST(CliSort, UniformLasColumnsAreStoredOnce) {
     EXPECT_EQ(scanInfo.out.find("uniform"), std::string::npos) << scanInfo.out;
 }
 
-TEST(CliSort, BadInputFailsWithExitOneAndLeavesNoOutput) {
-    test::TempDir dir;
+// A PLY that declares 10 vertices and holds none: dir/broken.ply.
+std::string writeBrokenPly(const test::TempDir& dir) {
     const std::string broken = dir.file("broken.ply");
     test::writeText(broken, "ply\nformat binary_little_endian 1.0\nelement vertex 10\n"
                             "property float x\nproperty float y\nproperty float z\nend_header\n");
+    return broken;
+}
+
+TEST(CliSort, BadInputFailsWithExitOneAndLeavesNoOutput) {
+    test::TempDir dir;
+    const std::string broken = writeBrokenPly(dir);
     const std::string oms = dir.file("out.oms");
     const auto result = runProcess(OMICRON_CLI_PATH, {"sort", broken, oms});
     EXPECT_EQ(result.exitCode, 1);
@@ -164,9 +170,7 @@ TEST(CliSort, BadInputFailsWithExitOneAndLeavesNoOutput) {
 // is the output's), leaving nothing behind.
 TEST(CliSort, AnUnwritableOutputFailsBeforeTheInputIsRead) {
     test::TempDir dir;
-    const std::string broken = dir.file("broken.ply");
-    test::writeText(broken, "ply\nformat binary_little_endian 1.0\nelement vertex 10\n"
-                            "property float x\nproperty float y\nproperty float z\nend_header\n");
+    const std::string broken = writeBrokenPly(dir);
     const std::string missing = dir.file("no-such-folder");
     for (const std::vector<std::string>& args :
          {std::vector<std::string>{"sort", broken, missing + "/out.oms"},
