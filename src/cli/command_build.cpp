@@ -177,15 +177,16 @@ int runBuild(const std::vector<std::string>& args) {
                                     static_cast<std::size_t>(build.threads));
 
     const std::string& path = parsed.positionals[0];
-    if (parsed.value("save-version") && !parsed.value("save")) {
+    const std::optional<std::string> savePath = parsed.value("save");
+    if (parsed.value("save-version") && !savePath) {
         throw UsageError("--save-version needs --save");
     }
     const OmhWriteOptions writeOptions = saveOptions(parsed); // a bad version before the build
-    const MemoryOptions memory = memoryOptions(parsed, parsed.value("save").value_or(""));
+    const MemoryOptions memory = memoryOptions(parsed, savePath.value_or(""));
     // The save's temporary file is made now: a target that cannot be written fails before the
     // build, not after it (an hour, for a billion points).
     std::optional<AtomicFileWriter> saveFile;
-    if (const auto savePath = parsed.value("save")) {
+    if (savePath) {
         saveFile.emplace(*savePath);
     }
     BuildPipeline pipeline;
@@ -194,7 +195,7 @@ int runBuild(const std::vector<std::string>& args) {
                                                  memory.budgetBytes, memory.tempDir,
                                                  /*preview=*/false});
     SavedFile saved;
-    if (const auto savePath = parsed.value("save")) { // the finished hierarchy, pipeline 3's input
+    if (saveFile) { // the finished hierarchy, pipeline 3's input
         writeOmh(*saveFile, *pipeline.hierarchy(), omhBuildInfo(options, run.stats), writeOptions);
         saved = {*savePath, std::filesystem::file_size(*savePath)};
     }

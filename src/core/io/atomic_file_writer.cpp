@@ -17,7 +17,6 @@
 #include <string>
 #include <sys/stat.h>
 #include <sys/vfs.h>
-#include <system_error>
 #include <unistd.h>
 
 namespace omicron {
@@ -81,7 +80,7 @@ AtomicFileWriter::AtomicFileWriter(std::string targetPath) : m_targetPath(std::m
 }
 
 AtomicFileWriter::~AtomicFileWriter() {
-    stopFlushing();
+    m_flusher.reset(); // its thread uses the descriptor
     if (m_fd >= 0) {
         ::close(m_fd);
     }
@@ -188,57 +187,14 @@ void AtomicFileWriter::extendTo(std::uint64_t size) {
 void AtomicFileWriter::startWriteBack(std::uint64_t offset, std::uint64_t count) {
     sync_file_range(m_fd, static_cast<off_t>(offset), static_cast<off_t>(count),
                     SYNC_FILE_RANGE_WRITE);
-    requestFlush();
-}
-
-void AtomicFileWriter::requestFlush() {
-    const std::lock_guard lock(m_flushMutex);
-    m_flushRequested = true;
-    if (!m_flusher.joinable() && !m_flushStop) { // started with the first window written back
-        try {
-            m_flusher = std::thread([this] { flushLoop(); });
-        } catch (const std::system_error&) {
-            m_flushStop = true; // no thread to spare: commit()'s fsync persists it all, as before
-        }
+    if (!m_flusher) { // a big file: the first window is written back
+        m_flusher = std::make_unique<FileFlusher>(m_fd);
     }
-    m_flushWake.notify_one();
-}
-
-void AtomicFileWriter::flushLoop() {
-    std::unique_lock lock(m_flushMutex);
-    while (true) {
-        m_flushWake.wait(lock, [this] { return m_flushRequested || m_flushStop; });
-        if (m_flushStop) {
-            return; // commit()'s fsync persists the rest
-        }
-        m_flushRequested = false;
-        lock.unlock();
-        // The data only: the file's size and blocks were set when it was extended, and its
-        // times are commit()'s fsync's.
-        const int error = ::fdatasync(m_fd) == 0 ? 0 : errno;
-        lock.lock();
-        ++m_flushes;
-        if (error != 0 && m_flushError == 0) {
-            m_flushError = error; // reported once per descriptor: commit() must see it here
-        }
-    }
-}
-
-int AtomicFileWriter::stopFlushing() {
-    {
-        const std::lock_guard lock(m_flushMutex);
-        m_flushStop = true;
-    }
-    m_flushWake.notify_one();
-    if (m_flusher.joinable()) {
-        m_flusher.join();
-    }
-    return m_flushError;
+    m_flusher->request();
 }
 
 std::uint64_t AtomicFileWriter::backgroundFlushes() const {
-    const std::lock_guard lock(m_flushMutex);
-    return m_flushes;
+    return m_flusher ? m_flusher->flushes() : 0;
 }
 
 void AtomicFileWriter::dropFromCache(std::uint64_t offset, std::uint64_t count) {
@@ -276,7 +232,7 @@ void AtomicFileWriter::nameTemporary() {
 
 void AtomicFileWriter::commit() {
     flushBuffer();
-    if (const int error = stopFlushing(); error != 0) {
+    if (const int error = m_flusher ? m_flusher->stop() : 0; error != 0) {
         fail("fsync failed", error);
     }
     if (::fsync(m_fd) != 0) {

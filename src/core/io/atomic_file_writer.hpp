@@ -7,26 +7,18 @@
 // naming its temporary and the rename leaves) are removed by the next writer of the same target
 // once their process is gone (leftover_files.hpp).
 //
-// A big file is made durable while it is written: each time a writer starts the write-back of
-// a window (startWriteBack, io/write_behind.hpp), a thread of the writer's own asks the disk to
-// persist what it has (fdatasync), so commit()'s fsync is left with the last part. Persisting
-// costs the disk time proportional to what is not yet persisted, and on a VM whose disk is
-// cached by the host it is the host writing to its own disk: 0.18 s for 433 MB here even when
-// every page had been written back ten seconds before. At the end of a save that time came
-// after the last byte; spread over the save it mostly overlaps the writing (24.2 M-point
-// `build --save` to a disk: final fsync 0.19 s -> 0.02-0.05 s).
+// A big file is persisted while it is written (io/file_flusher.hpp).
 #pragma once
 
+#include "io/file_flusher.hpp"
 #include "io/scratch_bytes.hpp"
 #include "io/write_behind.hpp"
 
-#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
-#include <mutex>
+#include <memory>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -63,8 +55,8 @@ public:
     void extendTo(std::uint64_t size);
 
     // For regions filled with writeAt: starts writing [offset, offset + count) back to disk
-    // (and has the disk persist what it holds of the file, on the writer's own thread),
-    // or waits for that and drops it from the page cache (io/write_behind.hpp).
+    // (and has the disk persist what it holds of the file: io/file_flusher.hpp), or waits for
+    // that and drops it from the page cache (io/write_behind.hpp).
     void startWriteBack(std::uint64_t offset, std::uint64_t count);
     void dropFromCache(std::uint64_t offset, std::uint64_t count);
 
@@ -81,11 +73,6 @@ private:
     [[noreturn]] void fail(const std::string& what, int error);
     // Gives the nameless temporary its hidden name beside the target, for the rename.
     void nameTemporary();
-    // The persisting thread: asks for a flush (starting the thread the first time), or stops
-    // it and returns the first error a flush met (0: none).
-    void requestFlush();
-    int stopFlushing();
-    void flushLoop();
 
     std::string m_targetPath;
     std::string m_tempPath; // empty while the temporary has no name
@@ -101,14 +88,7 @@ private:
     // written front to back), dropped again by commit() once the file is persisted.
     std::vector<std::pair<std::uint64_t, std::uint64_t>> m_dropped;
     bool m_committed = false;
-    // The persisting thread and what it shares with the writers, under m_flushMutex.
-    std::thread m_flusher;
-    mutable std::mutex m_flushMutex;
-    std::condition_variable m_flushWake;
-    bool m_flushRequested = false;
-    bool m_flushStop = false;
-    int m_flushError = 0; // the first errno a background flush met: commit() reports it
-    std::uint64_t m_flushes = 0;
+    std::unique_ptr<FileFlusher> m_flusher; // from the first window written back
 };
 
 } // namespace omicron
