@@ -79,6 +79,7 @@ void printJson(const PipelineResult& run, const BuildOptions& options, const Sav
     json.key("read_s").value(run.readSeconds);
     json.key("sort_s").value(run.sortSeconds);
     json.key("sort_runs").value(static_cast<std::uint64_t>(run.sortRuns));
+    json.key("recycled_bytes").value(run.recycledBytes);
     json.key("bytes_resident").value(static_cast<std::uint64_t>(s.bytesResident()));
     json.key("point_storage").value(toString(s.pointStorage));
     json.key("pages").value(pagesInUse());

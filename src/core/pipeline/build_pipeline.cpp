@@ -4,6 +4,7 @@
 #include "formats/oms_reader.hpp"
 #include "io/overlapped_batch_consumer.hpp"
 #include "memory_budget.hpp"
+#include "points/huge_page_buffer.hpp"
 #include "scene/scene_generator.hpp"
 
 #include <algorithm>
@@ -245,6 +246,7 @@ PipelineResult BuildPipeline::sortIntoBuilder(IncrementalMortonSorter& sorter,
         sorter.sortAndEmit(builder.consumer());
         result.sortSeconds = secondsSince(sortStart);
         result.sortRuns = sorter.runCount();
+        result.recycledBytes = std::uint64_t{sorter.pagesRecycled()} * kSmallPageBytes;
     }
     {
         // The sorter's unsorted copy of the input (or its runs) is as large as the cloud:

@@ -97,6 +97,9 @@ struct PipelineResult {
     double readSeconds = 0.0; // streaming the points (and, for .oms, the sorted ranges)
     double sortSeconds = 0.0; // sorter emission after the read; 0 for .oms and rebuild
     std::size_t sortRuns = 0; // runs spilled to disk and merged (0: sorted in memory)
+    // Bytes of the input's pages moved into the sorted cloud rather than faulted in anew
+    // (IncrementalMortonSorter::pagesRecycled).
+    std::uint64_t recycledBytes = 0;
     // A .omh larger than the memory budget: its nodes were loaded, their points are paged in
     // as a front asks for them (hierarchy()->residency()).
     bool pagedPoints = false;

@@ -12,20 +12,14 @@
 
 namespace omicron {
 
-namespace {
-
-constexpr std::uintptr_t kPage = kSmallPageBytes;
-
-std::uintptr_t pageUp(std::uintptr_t address) {
-    return (address + kPage - 1) & ~(kPage - 1);
+PageRecycler::PageRecycler(std::span<std::byte> recipient, std::size_t pageBytes)
+    : m_pageBytes(pageBytes), m_frontier(reinterpret_cast<std::uintptr_t>(recipient.data())),
+      m_end(wholePages(recipient.data(), recipient.size(), pageBytes).last) {
+    assert(m_frontier % m_pageBytes == 0);
 }
 
-} // namespace
-
-PageRecycler::PageRecycler(std::span<std::byte> recipient)
-    : m_frontier(reinterpret_cast<std::uintptr_t>(recipient.data())),
-      m_end(wholePages(recipient.data(), recipient.size(), kPage).last) {
-    assert(m_frontier % kPage == 0);
+std::uintptr_t PageRecycler::pageUp(std::uintptr_t address) const {
+    return (address + m_pageBytes - 1) & ~(m_pageBytes - 1);
 }
 
 PageRecycler::~PageRecycler() {
@@ -33,7 +27,7 @@ PageRecycler::~PageRecycler() {
 }
 
 void PageRecycler::donate(const void* memory, std::size_t bytes) {
-    const auto [first, last] = wholePages(memory, bytes, kPage);
+    const auto [first, last] = wholePages(memory, bytes, m_pageBytes);
     if (last <= first) {
         return;
     }
@@ -65,7 +59,7 @@ void PageRecycler::prepare(const void* end) {
             break;
         }
         ++m_moves;
-        m_pagesMoved += bytes / kPage;
+        m_pagesMoved += bytes / kSmallPageBytes;
         m_frontier += bytes;
         donation.begin += bytes;
         donation.bytes -= bytes;

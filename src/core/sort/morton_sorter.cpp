@@ -142,13 +142,18 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
                         column(m_input.colors, sizeof(m_input.colors[0])),
                         column(m_input.intensities, sizeof(m_input.intensities[0])),
                         column(m_input.las, m_input.attributes.lasBytes())};
-    if (m_options.recyclePages.value_or(!hugePagesPayOff())) {
+    if (m_options.recyclePages.value_or(true)) {
+        // On huge pages a page is moved whole, or the move would split it.
+        m_recyclePageBytes = m_options.recyclePageBytes != 0 ? m_options.recyclePageBytes
+                             : hugePagesPayOff()             ? kHugePageBytes
+                                                             : kSmallRecyclePage;
         const SortedCloud::InPlaceArrays sorted = m_cloud->inPlaceArrays();
         const std::array<std::span<std::byte>, kColumns> recipients{
             sorted.positions, sorted.normals, sorted.colors, sorted.intensities, sorted.las};
         for (std::size_t column = 0; column < recipients.size(); ++column) {
             if (!recipients[column].empty()) {
-                m_recyclers[column] = std::make_unique<PageRecycler>(recipients[column]);
+                m_recyclers[column] =
+                    std::make_unique<PageRecycler>(recipients[column], m_recyclePageBytes);
             }
         }
     }
@@ -355,13 +360,65 @@ IncrementalMortonSorter::blocksDoneAfterChunk(const std::vector<std::size_t>& bo
     return done;
 }
 
+std::vector<IncrementalMortonSorter::DonatedPages> IncrementalMortonSorter::pagesDoneAfterChunk(
+    const std::vector<std::vector<std::size_t>>& blocksDone) const {
+    std::vector<DonatedPages> done(blocksDone.size());
+    std::vector<std::size_t> blockDoneChunk(m_blockLastBin.size(), 0);
+    for (std::size_t c = 0; c < blocksDone.size(); ++c) {
+        for (const std::size_t block : blocksDone[c]) {
+            blockDoneChunk[block] = c;
+        }
+    }
+    const std::size_t points = m_input.size();
+    const std::size_t page = m_recyclePageBytes;
+    for (std::size_t column = 0; column < kColumns; ++column) {
+        const ArrivalColumn& arrival = m_arrivalColumns[column];
+        if (!recyclesByPage(column) || arrival.base == nullptr || points == 0) {
+            continue;
+        }
+        const auto base = reinterpret_cast<std::uintptr_t>(arrival.base);
+        const std::size_t pointBytes = arrival.pointBytes;
+        const WholePages pages = wholePages(arrival.base, points * pointBytes, page);
+        for (std::uintptr_t first = pages.first; first < pages.last; first += page) {
+            const std::size_t firstPoint = (first - base) / pointBytes;
+            const std::size_t endPoint =
+                std::min(points, (first + page - base + pointBytes - 1) / pointBytes);
+            std::size_t chunk = 0;
+            for (std::size_t block = firstPoint >> kReleaseBlockBits;
+                 block <= (endPoint - 1) >> kReleaseBlockBits; ++block) {
+                chunk = std::max(chunk, blockDoneChunk[block]);
+            }
+            done[chunk][column].push_back(first);
+        }
+    }
+    return done;
+}
+
+void IncrementalMortonSorter::donateInputPages(const DonatedPages& pages) {
+    for (std::size_t column = 0; column < kColumns; ++column) {
+        for (const std::uintptr_t page : pages[column]) {
+            m_recyclers[column]->donate(reinterpret_cast<const void*>(page), m_recyclePageBytes);
+        }
+    }
+}
+
+void IncrementalMortonSorter::releaseRecycledColumnsRest() {
+    for (std::size_t column = 0; column < kColumns; ++column) {
+        const ArrivalColumn& arrival = m_arrivalColumns[column];
+        if (recyclesByPage(column) && arrival.base != nullptr) {
+            // The donated pages read as zero already; this frees the partial ones at the ends.
+            releasePages(arrival.base, m_input.size() * arrival.pointBytes);
+        }
+    }
+}
+
 void IncrementalMortonSorter::releaseInputBlock(std::size_t block) {
     const std::size_t begin = block << kReleaseBlockBits;
     const std::size_t count =
         std::min(m_input.size(), begin + (std::size_t{1} << kReleaseBlockBits)) - begin;
     // Into the sorted cloud's next pages where a recycler takes them, else to the kernel.
     const auto release = [&](std::size_t column, const auto& array, std::size_t pointBytes) {
-        if (array.empty()) {
+        if (array.empty() || recyclesByPage(column)) {
             return;
         }
         const auto* memory = reinterpret_cast<const std::uint8_t*>(array.data());
@@ -431,6 +488,7 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
     if (m_cloud->uniformLasColumn()) {
         m_recyclers[kLas].reset();
     }
+    const std::vector<DonatedPages> pagesDone = pagesDoneAfterChunk(blocksDone);
 
     // Written before they are read: not zero-filled (a pass over 18 MB for 24.2 M points).
     const auto keys = std::make_unique_for_overwrite<std::uint64_t[]>(largestChunk);
@@ -540,6 +598,7 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                    for (const std::size_t block : blocksDone[c]) {
                        releaseInputBlock(block);
                    }
+                   donateInputPages(pagesDone[c]);
                    cloud.publish(chunkBegin[c + 1]);
                    return c;
                }) &
@@ -559,6 +618,7 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                        }
                        ++chunksDone;
                    }));
+    releaseRecycledColumnsRest();
     for (std::unique_ptr<PageRecycler>& recycler : m_recyclers) {
         if (recycler) {
             m_pagesRecycled += recycler->pagesMoved();

@@ -51,9 +51,11 @@ struct SortOptions {
     std::uint64_t memoryBudgetBytes = 0;
     std::string tempDir = {};
     // An in-memory sort moves the input's pages into the sorted cloud as it gives them back
-    // (points/page_recycler.hpp) rather than let the cloud fault in fresh ones; default: where
-    // huge pages do not pay off (the cloud is on small pages then). Tests force either way.
+    // (points/page_recycler.hpp) rather than let the cloud fault in fresh ones (default: yes;
+    // tests force either way), whole pages of `recyclePageBytes`: 0 for the cloud's own page
+    // size (2 MiB where huge pages pay off, else 4 KiB), or a power of two from 4 KiB.
     std::optional<bool> recyclePages = std::nullopt;
+    std::size_t recyclePageBytes = 0;
 };
 
 // Receives [begin, end) of `cloud`, already published: every code in it is >= every code of
@@ -112,7 +114,8 @@ public:
     // whatever the cloud's size (how `omicron-cli sort` writes a .oms). Call once.
     void emitSortedBatches(const SortedBatchConsumer& consumer);
 
-    // Pages of the input moved into the sorted cloud (PageRecycler) by sortAndEmit().
+    // Pages of the input moved into the sorted cloud (PageRecycler) by sortAndEmit(), counted
+    // in 4 KiB pages whatever the size moved.
     std::size_t pagesRecycled() const { return m_pagesRecycled; }
 
     // Seconds from the start of sortAndEmit() to the first consumer call (-1 before it).
@@ -165,6 +168,23 @@ private:
     // the kernel).
     enum Column : std::size_t { kPositions, kNormals, kColors, kIntensities, kLas, kColumns };
     std::array<std::unique_ptr<PageRecycler>, kColumns> m_recyclers;
+    // The recyclers' page size: small pages go back block by block (releaseInputBlock), larger
+    // ones a page at a time (pagesDoneAfterChunk).
+    std::size_t m_recyclePageBytes = 0;
+    bool recyclesByPage(std::size_t column) const {
+        return m_recyclers[column] != nullptr && m_recyclePageBytes > kSmallRecyclePage;
+    }
+    static constexpr std::size_t kSmallRecyclePage = 4096;
+    // For each chunk, per column that recycles its pages, the arrival array's whole pages (of
+    // the recycler's size) none of whose points a later chunk gathers: a page larger than a
+    // block is given back once the last of its blocks is done.
+    using DonatedPages = std::array<std::vector<std::uintptr_t>, kColumns>;
+    std::vector<DonatedPages>
+    pagesDoneAfterChunk(const std::vector<std::vector<std::size_t>>& blocksDone) const;
+    // What pagesDoneAfterChunk() donates of the arrival arrays, and what no whole page holds,
+    // given back at the end (the head and tail pages of each array).
+    void donateInputPages(const DonatedPages& pages);
+    void releaseRecycledColumnsRest();
     // Per column, the arrival array's reserved memory and bytes per point (null: no column),
     // fixed once reserved: populateAhead() uses these, never the arrays themselves.
     struct ArrivalColumn {

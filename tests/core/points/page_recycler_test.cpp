@@ -2,10 +2,14 @@
 // the donor reads zero afterwards; what is not used goes back to the kernel.
 #include "points/page_recycler.hpp"
 
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <gtest/gtest.h>
 #include <memory>
+#include <sstream>
+#include <string>
 #include <sys/mman.h>
 
 namespace omicron {
@@ -112,6 +116,76 @@ TEST(PageRecycler, MovesStopAtTheMappingLimitAndPagesGoBack) {
     EXPECT_EQ(donor.at(2 * (donations - 1) * kPage), 0);         // given back
     recycler.donate(donor.data + kPage, kPage);                  // from now on: given back
     EXPECT_EQ(donor.at(kPage), 0);
+}
+
+constexpr std::size_t kHugePage = std::size_t{2} << 20;
+
+// `pages` huge pages aligned to 2 MiB and advised huge (where the kernel allows them).
+struct HugeMapping {
+    explicit HugeMapping(std::size_t pages) : bytes(pages * kHugePage) {
+        void* memory = mmap(nullptr, bytes + kHugePage, PROT_READ | PROT_WRITE,
+                            MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        EXPECT_NE(memory, MAP_FAILED);
+        mapped = static_cast<std::byte*>(memory);
+        const auto aligned =
+            (reinterpret_cast<std::uintptr_t>(memory) + kHugePage - 1) & ~(kHugePage - 1);
+        data = reinterpret_cast<std::byte*>(aligned);
+        madvise(data, bytes, MADV_HUGEPAGE);
+    }
+    ~HugeMapping() { munmap(mapped, bytes + kHugePage); }
+    std::uint8_t at(std::size_t offset) const {
+        return std::to_integer<std::uint8_t>(data[offset]);
+    }
+    std::byte* mapped;
+    std::byte* data;
+    std::size_t bytes;
+};
+
+// AnonHugePages (KiB) of the mapping that holds `address`, from /proc/self/smaps.
+std::size_t anonHugeKiB(const void* address) {
+    std::ifstream smaps("/proc/self/smaps");
+    const auto at = reinterpret_cast<std::uintptr_t>(address);
+    bool inside = false;
+    for (std::string line; std::getline(smaps, line);) {
+        std::uintptr_t begin = 0;
+        std::uintptr_t end = 0;
+        char dash = 0;
+        std::istringstream range(line);
+        if (range >> std::hex >> begin >> dash >> end && dash == '-') {
+            inside = begin <= at && at < end;
+        } else if (inside && line.rfind("AnonHugePages:", 0) == 0) {
+            return std::stoul(line.substr(14));
+        }
+    }
+    return 0;
+}
+
+// On huge pages a whole 2 MiB page moves, with its bytes, and stays one huge page (the kernel
+// moves its one table entry); the partial pages around a donation stay with the donor.
+TEST(PageRecycler, HugePagesMoveWholeAndStayHuge) {
+    HugeMapping donor(3);
+    HugeMapping recipient(4);
+    for (std::size_t page = 0; page < 3; ++page) {
+        std::memset(donor.data + page * kHugePage, static_cast<int>(page + 1), kHugePage);
+    }
+    const bool donorHuge = anonHugeKiB(donor.data + kHugePage) >= 2048;
+    PageRecycler recycler({recipient.data, recipient.bytes}, kHugePage);
+    // Half of page 0, page 1 whole, half of page 2: only page 1 is donated.
+    recycler.donate(donor.data + kHugePage / 2, 2 * kHugePage);
+    recycler.prepare(recipient.data + 1); // the recipient's page 0 is about to be written
+    EXPECT_EQ(recycler.pagesMoved(), kHugePage / kPage);
+    EXPECT_EQ(recycler.moves(), 1u);
+    EXPECT_EQ(recipient.at(0), 2);
+    EXPECT_EQ(recipient.at(kHugePage - 1), 2);
+    EXPECT_EQ(donor.at(kHugePage), 0);
+    EXPECT_EQ(donor.at(kHugePage - 1), 1);
+    EXPECT_EQ(donor.at(2 * kHugePage), 3);
+    if (donorHuge) {
+        EXPECT_GE(anonHugeKiB(recipient.data), 2048u) << "the move split the huge page";
+    }
+    recycler.prepare(recipient.data + kHugePage + 1); // nothing donated: faulted in
+    EXPECT_EQ(recycler.pagesMoved(), kHugePage / kPage);
+    EXPECT_EQ(recipient.at(kHugePage), 0);
 }
 
 } // namespace

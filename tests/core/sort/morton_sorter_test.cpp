@@ -87,11 +87,12 @@ struct SortRun {
 // (populateAhead, as the reader does while it waits for the sorter).
 SortRun sortCloud(const SyntheticCloud& cloud, int chunks, std::size_t feedBatch = 10000,
                   std::size_t emitBatch = 5000, std::optional<bool> recyclePages = std::nullopt,
-                  bool populating = false) {
+                  bool populating = false, std::size_t recyclePageBytes = 0) {
     SortOptions options;
     options.chunks = chunks;
     options.batchPoints = emitBatch;
     options.recyclePages = recyclePages;
+    options.recyclePageBytes = recyclePageBytes;
     IncrementalMortonSorter sorter(cloud.info, options);
     std::atomic<std::size_t> added{0};
     std::atomic<bool> reading{true};
@@ -204,16 +205,23 @@ TEST(MortonSorter, InputGivenBackWhileSortingKeepsEveryAttribute) {
     }
 }
 
-// Where huge pages do not pay off, given-back input pages are moved into the sorted cloud
-// instead of faulting fresh ones: the moved pages hold stale input until the gather overwrites
-// them, so a page moved under a range already written, or one not written over, shows here.
-TEST(MortonSorter, InputPagesMovedIntoTheSortedCloudKeepEveryAttribute) {
+// Given-back input pages are moved into the sorted cloud instead of faulting fresh ones (4 KiB
+// pages block by block; 2 MiB pages, on huge pages, once every block they hold is done): the
+// moved pages hold stale input until the gather overwrites them, so a page moved under a range
+// already written, or one not written over, or given back while a later chunk still gathers
+// from it, shows here.
+class MortonSorterRecycling : public ::testing::TestWithParam<std::size_t> {};
+
+TEST_P(MortonSorterRecycling, InputPagesMovedIntoTheSortedCloudKeepEveryAttribute) {
+    const std::size_t pageBytes = GetParam();
+    // A few dozen pages of each column either way.
+    const std::size_t points = pageBytes == 4096 ? 330000 : 700000;
     for (const Shape shape : {Shape::MortonOrdered, Shape::Random, Shape::TwoClusters}) {
         SCOPED_TRACE(static_cast<int>(shape));
-        const SyntheticCloud cloud = makeCloud(shape, 330000, 11);
+        const SyntheticCloud cloud = makeCloud(shape, points, 11);
         for (int chunks : {1, 7, 32}) {
             SCOPED_TRACE(chunks);
-            const SortRun moved = sortCloud(cloud, chunks, 65536, 65536, true);
+            const SortRun moved = sortCloud(cloud, chunks, 65536, 65536, true, false, pageBytes);
             const SortRun faulted = sortCloud(cloud, chunks, 65536, 65536, false);
             expectSortedPermutation(cloud, moved);
             EXPECT_EQ(moved.normals, faulted.normals);
@@ -224,6 +232,9 @@ TEST(MortonSorter, InputPagesMovedIntoTheSortedCloudKeepEveryAttribute) {
         }
     }
 }
+
+INSTANTIATE_TEST_SUITE_P(PageSizes, MortonSorterRecycling,
+                         ::testing::Values(std::size_t{4096}, std::size_t{2} << 20));
 
 // The reader faults arrival pages in while the sorter adds: the sort is the same point for
 // point, whichever thread touched a page first, and pages moved into the sorted cloud later
