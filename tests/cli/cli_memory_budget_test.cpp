@@ -70,6 +70,9 @@ TEST(CliMemoryBudget, SpilledBuildGivesTheSameLevels) {
                                  scratch.path().string()});
     ASSERT_EQ(spilled.exitCode, 0) << spilled.err;
     EXPECT_FALSE(contains(spilled.out, "\"sort_runs\":0")) << spilled.out;
+    // Runs merged from disk have no input pages to move into the cloud.
+    EXPECT_TRUE(contains(reference.out, "\"recycled_bytes\":")) << reference.out;
+    EXPECT_TRUE(contains(spilled.out, "\"recycled_bytes\":0,")) << spilled.out;
     EXPECT_FALSE(levelsOf(reference.out).empty());
     EXPECT_EQ(levelsOf(spilled.out), levelsOf(reference.out));
     EXPECT_TRUE(std::filesystem::is_empty(scratch.path()));
