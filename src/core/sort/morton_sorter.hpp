@@ -144,7 +144,8 @@ private:
     };
 
     // The input is given back a block of points at a time, once every chunk that gathers from
-    // the block has been sorted: blockLastBin is the highest bin of the block's points.
+    // the block has been sorted: blockLastBin is the highest bin of the block's points. (A
+    // column recycled in huge pages goes back a whole page at a time: pagesDoneAfterChunk.)
     static constexpr int kReleaseBlockBits = 16;
 
     std::vector<std::size_t> chunkBinBoundaries() const;
