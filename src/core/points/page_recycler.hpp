@@ -21,6 +21,8 @@
 // pages are given back as before; a refused move (an old kernel) stops them too.
 #pragma once
 
+#include "points/huge_page_buffer.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <deque>
@@ -35,7 +37,7 @@ public:
     // `recipient`: an array aligned to `pageBytes` (4 KiB, or 2 MiB for arrays on huge pages)
     // owned by the caller, whose bytes are written front to back, each range announced by
     // prepare() first, and never touched before that.
-    explicit PageRecycler(std::span<std::byte> recipient, std::size_t pageBytes = 4096);
+    explicit PageRecycler(std::span<std::byte> recipient, std::size_t pageBytes = kSmallPageBytes);
     // Gives back the donations no prepare() used.
     ~PageRecycler();
     PageRecycler(const PageRecycler&) = delete;

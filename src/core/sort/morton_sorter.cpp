@@ -146,7 +146,7 @@ IncrementalMortonSorter::IncrementalMortonSorter(const CloudInfo& info, const So
         // On huge pages a page is moved whole, or the move would split it.
         m_recyclePageBytes = m_options.recyclePageBytes != 0 ? m_options.recyclePageBytes
                              : hugePagesPayOff()             ? kHugePageBytes
-                                                             : kSmallRecyclePage;
+                                                             : kSmallPageBytes;
         const SortedCloud::InPlaceArrays sorted = m_cloud->inPlaceArrays();
         const std::array<std::span<std::byte>, kColumns> recipients{
             sorted.positions, sorted.normals, sorted.colors, sorted.intensities, sorted.las};
@@ -345,30 +345,34 @@ std::vector<std::size_t> IncrementalMortonSorter::chunkBinBoundaries() const {
     return boundaries;
 }
 
-// For each chunk, the input blocks none of whose points a later chunk gathers.
-std::vector<std::vector<std::size_t>>
-IncrementalMortonSorter::blocksDoneAfterChunk(const std::vector<std::size_t>& boundaries) const {
-    std::vector<std::vector<std::size_t>> done(boundaries.size() - 1);
+std::vector<std::size_t>
+IncrementalMortonSorter::chunkDoneWithBlocks(const std::vector<std::size_t>& boundaries) const {
     const std::size_t blocks =
         (m_input.size() + (std::size_t{1} << kReleaseBlockBits) - 1) >> kReleaseBlockBits;
+    std::vector<std::size_t> chunks(blocks);
     for (std::size_t block = 0; block < blocks; ++block) {
         // The chunk whose bins hold the block's last bin: the first boundary above it, minus 1.
         const auto next = std::upper_bound(boundaries.begin(), boundaries.end(),
                                            std::size_t{m_blockLastBin[block]});
-        done[static_cast<std::size_t>(next - boundaries.begin()) - 1].push_back(block);
+        chunks[block] = static_cast<std::size_t>(next - boundaries.begin()) - 1;
+    }
+    return chunks;
+}
+
+std::vector<std::vector<std::size_t>>
+IncrementalMortonSorter::blocksDoneAfterChunk(const std::vector<std::size_t>& blockChunks,
+                                              std::size_t chunks) {
+    std::vector<std::vector<std::size_t>> done(chunks);
+    for (std::size_t block = 0; block < blockChunks.size(); ++block) {
+        done[blockChunks[block]].push_back(block);
     }
     return done;
 }
 
-std::vector<IncrementalMortonSorter::DonatedPages> IncrementalMortonSorter::pagesDoneAfterChunk(
-    const std::vector<std::vector<std::size_t>>& blocksDone) const {
-    std::vector<DonatedPages> done(blocksDone.size());
-    std::vector<std::size_t> blockDoneChunk(m_blockLastBin.size(), 0);
-    for (std::size_t c = 0; c < blocksDone.size(); ++c) {
-        for (const std::size_t block : blocksDone[c]) {
-            blockDoneChunk[block] = c;
-        }
-    }
+std::vector<IncrementalMortonSorter::DonatedPages>
+IncrementalMortonSorter::pagesDoneAfterChunk(const std::vector<std::size_t>& blockChunks,
+                                             std::size_t chunks) const {
+    std::vector<DonatedPages> done(chunks);
     const std::size_t points = m_input.size();
     const std::size_t page = m_recyclePageBytes;
     for (std::size_t column = 0; column < kColumns; ++column) {
@@ -386,7 +390,7 @@ std::vector<IncrementalMortonSorter::DonatedPages> IncrementalMortonSorter::page
             std::size_t chunk = 0;
             for (std::size_t block = firstPoint >> kReleaseBlockBits;
                  block <= (endPoint - 1) >> kReleaseBlockBits; ++block) {
-                chunk = std::max(chunk, blockDoneChunk[block]);
+                chunk = std::max(chunk, blockChunks[block]);
             }
             done[chunk][column].push_back(first);
         }
@@ -466,7 +470,9 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
     // Input read in a spatially coherent order (scan lines, tiles) is given back as the sort
     // proceeds instead of at its end: the peak is then less than the input and the sorted
     // cloud side by side. Input in random order is only given back at the end.
-    const std::vector<std::vector<std::size_t>> blocksDone = blocksDoneAfterChunk(boundaries);
+    const std::vector<std::size_t> blockChunks = chunkDoneWithBlocks(boundaries);
+    const std::vector<std::vector<std::size_t>> blocksDone =
+        blocksDoneAfterChunk(blockChunks, chunks);
 
     // Chunk c covers sorted positions [chunkBegin[c], chunkBegin[c + 1]).
     std::vector<std::size_t> chunkBegin(chunks + 1, 0);
@@ -488,7 +494,7 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
     if (m_cloud->uniformLasColumn()) {
         m_recyclers[kLas].reset();
     }
-    const std::vector<DonatedPages> pagesDone = pagesDoneAfterChunk(blocksDone);
+    const std::vector<DonatedPages> pagesDone = pagesDoneAfterChunk(blockChunks, chunks);
 
     // Written before they are read: not zero-filled (a pass over 18 MB for 24.2 M points).
     const auto keys = std::make_unique_for_overwrite<std::uint64_t[]>(largestChunk);

@@ -149,8 +149,11 @@ private:
     static constexpr int kReleaseBlockBits = 16;
 
     std::vector<std::size_t> chunkBinBoundaries() const;
-    std::vector<std::vector<std::size_t>>
-    blocksDoneAfterChunk(const std::vector<std::size_t>& boundaries) const;
+    // Per input block, the chunk after which no later chunk gathers from it.
+    std::vector<std::size_t> chunkDoneWithBlocks(const std::vector<std::size_t>& boundaries) const;
+    // The same grouped: for each chunk, the blocks it is the last to gather from.
+    static std::vector<std::vector<std::size_t>>
+    blocksDoneAfterChunk(const std::vector<std::size_t>& blockChunks, std::size_t chunks);
     void releaseInputBlock(std::size_t block);
     // Gives back the blocks of bins [first, end) (sorted, not read again) and empties them.
     void releaseBins(std::size_t first, std::size_t end);
@@ -173,15 +176,14 @@ private:
     // ones a page at a time (pagesDoneAfterChunk).
     std::size_t m_recyclePageBytes = 0;
     bool recyclesByPage(std::size_t column) const {
-        return m_recyclers[column] != nullptr && m_recyclePageBytes > kSmallRecyclePage;
+        return m_recyclers[column] != nullptr && m_recyclePageBytes > kSmallPageBytes;
     }
-    static constexpr std::size_t kSmallRecyclePage = 4096;
     // For each chunk, per column that recycles its pages, the arrival array's whole pages (of
     // the recycler's size) none of whose points a later chunk gathers: a page larger than a
     // block is given back once the last of its blocks is done.
     using DonatedPages = std::array<std::vector<std::uintptr_t>, kColumns>;
-    std::vector<DonatedPages>
-    pagesDoneAfterChunk(const std::vector<std::vector<std::size_t>>& blocksDone) const;
+    std::vector<DonatedPages> pagesDoneAfterChunk(const std::vector<std::size_t>& blockChunks,
+                                                  std::size_t chunks) const;
     // What pagesDoneAfterChunk() donates of the arrival arrays, and what no whole page holds,
     // given back at the end (the head and tail pages of each array).
     void donateInputPages(const DonatedPages& pages);

@@ -15,22 +15,32 @@
 namespace omicron {
 namespace {
 
-constexpr std::size_t kPage = 4096;
+constexpr std::size_t kPage = kSmallPageBytes;
 
-// A page-aligned anonymous mapping of `pages` pages, unmapped at the end.
+// An anonymous mapping of `pages` pages of `pageBytes`, aligned to them (and advised huge when
+// they are huge pages), unmapped at the end.
 struct Mapping {
-    explicit Mapping(std::size_t pages) : bytes(pages * kPage) {
-        void* memory =
-            mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    explicit Mapping(std::size_t pages, std::size_t pageBytes = kPage)
+        : bytes(pages * pageBytes), spare(pageBytes - kPage) {
+        void* memory = mmap(nullptr, bytes + spare, PROT_READ | PROT_WRITE,
+                            MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
         EXPECT_NE(memory, MAP_FAILED);
-        data = static_cast<std::byte*>(memory);
+        mapped = static_cast<std::byte*>(memory);
+        const auto aligned =
+            (reinterpret_cast<std::uintptr_t>(memory) + pageBytes - 1) & ~(pageBytes - 1);
+        data = reinterpret_cast<std::byte*>(aligned);
+        if (pageBytes > kPage) {
+            madvise(data, bytes, MADV_HUGEPAGE);
+        }
     }
-    ~Mapping() { munmap(data, bytes); }
+    ~Mapping() { munmap(mapped, bytes + spare); }
     std::uint8_t at(std::size_t offset) const {
         return std::to_integer<std::uint8_t>(data[offset]);
     }
+    std::byte* mapped;
     std::byte* data;
     std::size_t bytes;
+    std::size_t spare; // mapped beyond `bytes` to align them
 };
 
 TEST(PageRecycler, DonatedPagesBackTheRecipientsNextPages) {
@@ -118,29 +128,6 @@ TEST(PageRecycler, MovesStopAtTheMappingLimitAndPagesGoBack) {
     EXPECT_EQ(donor.at(kPage), 0);
 }
 
-constexpr std::size_t kHugePage = std::size_t{2} << 20;
-
-// `pages` huge pages aligned to 2 MiB and advised huge (where the kernel allows them).
-struct HugeMapping {
-    explicit HugeMapping(std::size_t pages) : bytes(pages * kHugePage) {
-        void* memory = mmap(nullptr, bytes + kHugePage, PROT_READ | PROT_WRITE,
-                            MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-        EXPECT_NE(memory, MAP_FAILED);
-        mapped = static_cast<std::byte*>(memory);
-        const auto aligned =
-            (reinterpret_cast<std::uintptr_t>(memory) + kHugePage - 1) & ~(kHugePage - 1);
-        data = reinterpret_cast<std::byte*>(aligned);
-        madvise(data, bytes, MADV_HUGEPAGE);
-    }
-    ~HugeMapping() { munmap(mapped, bytes + kHugePage); }
-    std::uint8_t at(std::size_t offset) const {
-        return std::to_integer<std::uint8_t>(data[offset]);
-    }
-    std::byte* mapped;
-    std::byte* data;
-    std::size_t bytes;
-};
-
 // AnonHugePages (KiB) of the mapping that holds `address`, from /proc/self/smaps.
 std::size_t anonHugeKiB(const void* address) {
     std::ifstream smaps("/proc/self/smaps");
@@ -163,29 +150,29 @@ std::size_t anonHugeKiB(const void* address) {
 // On huge pages a whole 2 MiB page moves, with its bytes, and stays one huge page (the kernel
 // moves its one table entry); the partial pages around a donation stay with the donor.
 TEST(PageRecycler, HugePagesMoveWholeAndStayHuge) {
-    HugeMapping donor(3);
-    HugeMapping recipient(4);
+    Mapping donor(3, kHugePageBytes);
+    Mapping recipient(4, kHugePageBytes);
     for (std::size_t page = 0; page < 3; ++page) {
-        std::memset(donor.data + page * kHugePage, static_cast<int>(page + 1), kHugePage);
+        std::memset(donor.data + page * kHugePageBytes, static_cast<int>(page + 1), kHugePageBytes);
     }
-    const bool donorHuge = anonHugeKiB(donor.data + kHugePage) >= 2048;
-    PageRecycler recycler({recipient.data, recipient.bytes}, kHugePage);
+    const bool donorHuge = anonHugeKiB(donor.data + kHugePageBytes) >= 2048;
+    PageRecycler recycler({recipient.data, recipient.bytes}, kHugePageBytes);
     // Half of page 0, page 1 whole, half of page 2: only page 1 is donated.
-    recycler.donate(donor.data + kHugePage / 2, 2 * kHugePage);
+    recycler.donate(donor.data + kHugePageBytes / 2, 2 * kHugePageBytes);
     recycler.prepare(recipient.data + 1); // the recipient's page 0 is about to be written
-    EXPECT_EQ(recycler.pagesMoved(), kHugePage / kPage);
+    EXPECT_EQ(recycler.pagesMoved(), kHugePageBytes / kPage);
     EXPECT_EQ(recycler.moves(), 1u);
     EXPECT_EQ(recipient.at(0), 2);
-    EXPECT_EQ(recipient.at(kHugePage - 1), 2);
-    EXPECT_EQ(donor.at(kHugePage), 0);
-    EXPECT_EQ(donor.at(kHugePage - 1), 1);
-    EXPECT_EQ(donor.at(2 * kHugePage), 3);
+    EXPECT_EQ(recipient.at(kHugePageBytes - 1), 2);
+    EXPECT_EQ(donor.at(kHugePageBytes), 0);
+    EXPECT_EQ(donor.at(kHugePageBytes - 1), 1);
+    EXPECT_EQ(donor.at(2 * kHugePageBytes), 3);
     if (donorHuge) {
         EXPECT_GE(anonHugeKiB(recipient.data), 2048u) << "the move split the huge page";
     }
-    recycler.prepare(recipient.data + kHugePage + 1); // nothing donated: faulted in
-    EXPECT_EQ(recycler.pagesMoved(), kHugePage / kPage);
-    EXPECT_EQ(recipient.at(kHugePage), 0);
+    recycler.prepare(recipient.data + kHugePageBytes + 1); // nothing donated: faulted in
+    EXPECT_EQ(recycler.pagesMoved(), kHugePageBytes / kPage);
+    EXPECT_EQ(recipient.at(kHugePageBytes), 0);
 }
 
 } // namespace
