@@ -3,6 +3,7 @@
 #include "build_args.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
+#include "formats/omh_column_stream.hpp"
 #include "formats/omh_writer.hpp"
 #include "interrupt.hpp"
 #include "io/atomic_file_writer.hpp"
@@ -17,6 +18,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -34,6 +36,7 @@ const char* pagesInUse() {
 struct SavedFile {
     std::string path; // empty without --save
     std::uint64_t bytes = 0;
+    std::uint64_t streamedBytes = 0; // the deepest level's columns written during the build
 };
 
 // --save-version, and a test hook (not a user option): with OMICRON_TEST_PAUSE_SAVE_AFTER_LEVEL=N
@@ -97,6 +100,7 @@ void printJson(const PipelineResult& run, const BuildOptions& options, const Sav
     if (!saved.path.empty()) {
         json.key("saved").value(saved.path);
         json.key("saved_bytes").value(saved.bytes);
+        json.key("saved_streamed_bytes").value(saved.streamedBytes);
     }
     json.endObject();
     std::printf("%s\n", json.text().c_str());
@@ -187,18 +191,32 @@ int runBuild(const std::vector<std::string>& args) {
     // The save's temporary file is made now: a target that cannot be written fails before the
     // build, not after it (an hour, for a billion points).
     std::optional<AtomicFileWriter> saveFile;
+    BuildPipeline pipeline;
+    // Where every leaf will be at the deepest level, a version 4 save's deepest level (the
+    // sorted cloud's arrays) goes to the file while the hierarchy is built
+    // (formats/omh_column_stream.hpp).
+    std::unique_ptr<OmhColumnStream> columnStream;
     if (savePath) {
         saveFile.emplace(*savePath);
+        if (options.collapse == LeafCollapse::Off &&
+            writeOptions.formatVersion >= omh::kFirstVersionWithDeepestColumns) {
+            columnStream = std::make_unique<OmhColumnStream>(
+                *saveFile, options.maxLevel, [&pipeline] { return pipeline.sortedCloud(); });
+        }
     }
-    BuildPipeline pipeline;
     const PipelineResult run = runInterruptibly(pipeline, path,
                                                 {options, build.sortChunks, build.storage,
                                                  memory.budgetBytes, memory.tempDir,
                                                  /*preview=*/false});
     SavedFile saved;
     if (saveFile) { // the finished hierarchy, pipeline 3's input
-        writeOmh(*saveFile, *pipeline.hierarchy(), omhBuildInfo(options, run.stats), writeOptions);
-        saved = {*savePath, std::filesystem::file_size(*savePath)};
+        const OmhStreamedColumns streamed =
+            columnStream ? columnStream->finish() : OmhStreamedColumns{};
+        OmhWriteOptions save = writeOptions;
+        save.streamedColumns = columnStream ? &streamed : nullptr;
+        const OmhSaveReport report =
+            writeOmh(*saveFile, *pipeline.hierarchy(), omhBuildInfo(options, run.stats), save);
+        saved = {*savePath, std::filesystem::file_size(*savePath), report.streamedBytesUsed};
     }
     if (parsed.flag("json")) {
         printJson(run, options, saved);
@@ -240,10 +258,12 @@ const Command& buildCommand() {
         "                     it was; the temporary is made before the build, so a target\n"
         "                     that cannot be written fails at once); 'info OUT.omh' prints\n"
         "                     the same per-level counts\n"
-        "  --save-version V   the .omh format version: 3 (default: splat attributes estimated\n"
-        "                     again when drawn, stored only for nodes of fewer than 8 points)\n"
-        "                     or 2 (stored for every point, 6 bytes more a point without\n"
-        "                     normals, 2 with; for omicron builds that read only version 2)\n"
+        "  --save-version V   the .omh format version: 4 (default: the deepest level as\n"
+        "                     columns before the node table, written while the hierarchy\n"
+        "                     is built), 3 (the same bytes as records in level order, for\n"
+        "                     omicron builds that read up to version 3) or 2 (splat\n"
+        "                     attributes stored for every point, 6 bytes more a point\n"
+        "                     without normals, 2 with; for builds that read only version 2)\n"
         "  --memory-budget SIZE\n"
         "                     what the sort may keep resident, e.g. 512M or 4G (default: half\n"
         "                     of physical memory); a bigger sort runs on disk and its runs are\n"
@@ -257,7 +277,8 @@ const Command& buildCommand() {
         "                     (cloud_bytes + hierarchy_bytes), point_storage, pages (huge\n"
         "                     or small: which the big arrays asked for, see README)\n"
         "                     milestones_s (time at 10 %, 20 %, ... of the points inserted),\n"
-        "                     saved and saved_bytes with --save\n"
+        "                     saved, saved_bytes and saved_streamed_bytes (of them, the\n"
+        "                     deepest level's written during the build) with --save\n"
         "\n"
         "Exit status: 0 ok, 1 input or output error, 2 usage error, 130 interrupted.\n",
         runBuild};

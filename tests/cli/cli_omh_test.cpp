@@ -64,32 +64,43 @@ TEST(CliOmh, VerifyExitsOneOnADamagedSectionAndNamesIt) {
                   .exitCode,
               0);
     std::vector<std::uint8_t> bytes = test::readBytes(saved);
-    bytes[bytes.size() - 100] ^= 0x10; // in the deepest level's point records
+    bytes[4096 + 100] ^= 0x10; // in the deepest level's positions (version 4: its columns first)
     test::writeBytes(saved, bytes);
     EXPECT_EQ(runProcess(OMICRON_CLI_PATH, {"info", saved}).exitCode, 0)
         << "without --verify only the header, level table and footer are read";
     const auto verify = runProcess(OMICRON_CLI_PATH, {"info", saved, "--verify"});
     EXPECT_EQ(verify.exitCode, 1);
     EXPECT_NE(verify.err.find(saved), std::string::npos) << verify.err;
-    EXPECT_NE(verify.err.find("point records of level 5"), std::string::npos) << verify.err;
+    EXPECT_NE(verify.err.find("columns of level 5"), std::string::npos) << verify.err;
 }
 
-TEST(CliOmh, SaveVersionTwoStoresEverySplatAndBothVersionsDescribeTheSameLevels) {
+TEST(CliOmh, SaveVersionsTwoToFourDescribeTheSameLevels) {
     OMICRON_REQUIRE_SHARED_FILE(input, "bunny.ply");
     test::TempDir dir;
-    const std::string v3 = dir.file("v3.omh"), v2 = dir.file("v2.omh");
-    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"build", input, "--depth", "4", "--save", v3}).exitCode,
+    const std::string v4 = dir.file("v4.omh"), v3 = dir.file("v3.omh"), v2 = dir.file("v2.omh");
+    ASSERT_EQ(runProcess(OMICRON_CLI_PATH, {"build", input, "--depth", "4", "--save", v4}).exitCode,
               0);
-    const auto build = runProcess(
-        OMICRON_CLI_PATH, {"build", input, "--depth", "4", "--save", v2, "--save-version", "2"});
-    ASSERT_EQ(build.exitCode, 0) << build.err;
+    for (const auto& [path, version] : {std::pair{v3, "3"}, std::pair{v2, "2"}}) {
+        const auto build = runProcess(OMICRON_CLI_PATH, {"build", input, "--depth", "4", "--save",
+                                                         path, "--save-version", version});
+        ASSERT_EQ(build.exitCode, 0) << build.err;
+    }
+    const auto infoV4 = runProcess(OMICRON_CLI_PATH, {"info", v4, "--json", "--verify"});
     const auto infoV3 = runProcess(OMICRON_CLI_PATH, {"info", v3, "--json", "--verify"});
     const auto infoV2 = runProcess(OMICRON_CLI_PATH, {"info", v2, "--json", "--verify"});
+    ASSERT_EQ(infoV4.exitCode, 0) << infoV4.err;
     ASSERT_EQ(infoV3.exitCode, 0) << infoV3.err;
     ASSERT_EQ(infoV2.exitCode, 0) << infoV2.err;
+    EXPECT_NE(infoV4.out.find("\"version\":4"), std::string::npos) << infoV4.out;
     EXPECT_NE(infoV3.out.find("\"version\":3"), std::string::npos) << infoV3.out;
     EXPECT_NE(infoV2.out.find("\"version\":2"), std::string::npos) << infoV2.out;
     EXPECT_EQ(levelsArray(infoV2.out), levelsArray(infoV3.out));
+    EXPECT_EQ(levelsArray(infoV4.out), levelsArray(infoV3.out));
+    // Version 4 holds the same bytes as version 3 but for the deepest level's columns: the
+    // padding to 4096-byte boundaries after the level table, after each column and after the
+    // last one (bunny: positions and normals, no colour).
+    EXPECT_GT(std::filesystem::file_size(v4), std::filesystem::file_size(v3));
+    EXPECT_LT(std::filesystem::file_size(v4), std::filesystem::file_size(v3) + 3 * 4096);
     const std::regex stored(R"re("points_stored":(\d+),"splat_attributes_stored":(\d+))re");
     std::smatch a, b;
     ASSERT_TRUE(std::regex_search(infoV2.out, a, stored)) << infoV2.out;
@@ -101,7 +112,7 @@ TEST(CliOmh, SaveVersionTwoStoresEverySplatAndBothVersionsDescribeTheSameLevels)
               2 * (std::stoull(b[1]) - std::stoull(b[2])) -
                   5 * 8) // 5 level entries, 8 bytes shorter
         << infoV2.out << infoV3.out;
-    for (const char* bad : {"1", "4", "three"}) {
+    for (const char* bad : {"1", "5", "three"}) {
         const auto refused = runProcess(
             OMICRON_CLI_PATH, {"build", input, "--save", dir.file("x.omh"), "--save-version", bad});
         EXPECT_EQ(refused.exitCode, 2) << bad;

@@ -8,11 +8,15 @@
 //   level table  L x 64 + 8 per level: nodes, leaves, points, node-table and payload offsets,
 //                           XXH3-64 of the level's node records and of its payload, the
 //                           points of its sparse nodes; then XXH64 of the entries
+//   (version 4)  the deepest level's payload: each field of its records as a column of its
+//                           own (positions, normals, colours, intensities, LAS column; each
+//                           from a 4096-byte boundary), then its sparse nodes' splat attributes
 //   node table   32 bytes per node, breadth first: level 0, then level 1 ... each level in
 //                           Morton order (code, first point, point count, splat scale, child
 //                           mask, flags)
 //   payload      per level: R bytes per held point, grouped by node in node-table order;
 //                           then the splat attributes of the points of its sparse nodes
+//                           (version 4: every level but the deepest)
 //   footer       32 bytes   magic "OMHEND\0\0", total nodes, total points, XXH64 of them
 //
 // Each level has its own checksums so a progressive reader verifies a level before it
@@ -41,9 +45,16 @@ inline constexpr std::array<char, 8> kFooterMagic{'O', 'M', 'H', 'E', 'N', 'D', 
 // node's points as a build does (the same bytes), except for the points of sparse nodes
 // (fewer than kMinPointsPerSplatEstimate points, whose estimate borrows points of other nodes),
 // stored after their level's records; the level entry gained their count (56 -> 64 bytes).
-inline constexpr std::uint32_t kVersion = 3;
+// Version 4 stores the deepest level (most of the points) as columns, right after the level
+// table, where its place depends only on the depth: they are the sorted cloud's arrays
+// verbatim, so `build --save` writes them from the cloud's memory while the hierarchy is still
+// being built (omh_column_stream.hpp), with direct I/O, neither encoding nor copying them.
+inline constexpr std::uint32_t kVersion = 4;
 inline constexpr std::uint32_t kOldestVersion = 1;
 inline constexpr std::uint32_t kFirstVersionWithoutSplatRecords = 3;
+inline constexpr std::uint32_t kFirstVersionWithDeepestColumns = 4;
+// Each column of the deepest level starts on a multiple of this (direct I/O's alignment).
+inline constexpr std::uint64_t kColumnAlignment = 4096;
 inline constexpr std::uint32_t kEndiannessMarker = oms::kEndiannessMarker;
 inline constexpr std::uint8_t kKnownAttributeBits = oms::kKnownAttributeBits;
 // Splat bit 0: a point's splat attributes include the estimated normal (the cloud has no
@@ -177,6 +188,28 @@ struct RecordLayout {
     }
 };
 
+// A field of a point record, stored as a column of its own in a columnar level (version 4's
+// deepest), in this order.
+enum class ColumnKind { Position, Normal, Color, Intensity, Las };
+struct Column {
+    ColumnKind kind;
+    std::size_t bytes; // per point
+};
+// The columns of records of `layout`: its fields, in record order.
+std::vector<Column> recordColumns(const RecordLayout& layout);
+const char* columnName(ColumnKind kind); // "position", "normal", ...
+
+constexpr std::uint64_t alignUp(std::uint64_t offset, std::uint64_t alignment) {
+    return (offset + alignment - 1) / alignment * alignment;
+}
+// Where each column of `points` points starts, relative to the first (which is aligned), and
+// where the last one ends: columns.size() + 1 values.
+std::vector<std::uint64_t> columnStarts(const std::vector<Column>& columns, std::uint64_t points);
+// The checksum of a columnar level's payload: XXH3-64 of the XXH3-64 digests of its columns
+// then of its sparse splat attributes, each as 8 little-endian bytes (the columns are hashed
+// separately, as they are written: side by side while the build publishes points).
+std::uint64_t columnarChecksum(const std::vector<std::uint64_t>& digests);
+
 // A node whose splat attributes a version 3 file stores (after its level's records): one too
 // sparse for an estimate from its own points. kMinPointsPerSplatEstimate's value is part of
 // the format.
@@ -208,6 +241,7 @@ struct LevelEntry {
     std::uint64_t nodeChecksum = 0;
     std::uint64_t payloadChecksum = 0;
     std::uint64_t sparsePoints = 0; // version 3: points of the nodes that storesSplats()
+    bool columnar = false; // version 4's deepest level: stored as columns (Header::setLevels)
 };
 
 // Everything the header and level table say.
@@ -232,27 +266,55 @@ struct Header {
     bool splatsInRecords() const { return version < kFirstVersionWithoutSplatRecords; }
     // Bytes of one point's stored splat attributes (in its record, or after its level's).
     std::size_t splatBytes() const { return omh::splatBytes(estimatedNormals); }
+    // Version 4: the deepest level is stored as columns.
+    bool columnar(const LevelEntry& level) const { return level.columnar; }
+    // Sizes the level table for `count` levels, marking the columnar one (set the version
+    // first).
+    void setLevelCount(std::size_t count) {
+        levels.assign(count, LevelEntry{});
+        if (version >= kFirstVersionWithDeepestColumns && count > 0) {
+            levels.back().columnar = true;
+        }
+    }
+    // The record layout's fields, as a columnar level stores them.
+    std::vector<Column> columns() const;
+    // A level's records: R bytes each, or (columnar) its columns with their alignment, up to
+    // the next multiple of kColumnAlignment.
+    std::uint64_t recordsBytes(const LevelEntry& level) const;
     // A level's payload: its records, then (version 3) its sparse nodes' splat attributes.
     std::uint64_t payloadBytes(const LevelEntry& level) const {
-        return level.points * recordBytes + level.sparsePoints * splatBytes();
+        return recordsBytes(level) + level.sparsePoints * splatBytes();
     }
     // Where the splat attributes of a level's sparse nodes start.
     std::uint64_t sparseSplatsOffset(const LevelEntry& level) const {
-        return level.payloadOffset + level.points * recordBytes;
+        return level.payloadOffset + recordsBytes(level);
     }
     std::uint64_t levelTableOffset() const { return kHeaderBytes; }
-    std::uint64_t nodeTableOffset() const {
+    std::uint64_t levelTableEnd() const {
         return kHeaderBytes + levels.size() * levelEntryBytes(version) + 8;
     }
+    // Version 4: where the deepest level's columns start (right after the level table).
+    std::uint64_t columnsOffset() const { return alignUp(levelTableEnd(), kColumnAlignment); }
+    std::uint64_t nodeTableOffset() const {
+        if (version < kFirstVersionWithDeepestColumns || levels.empty()) {
+            return levelTableEnd();
+        }
+        return columnsOffset() + payloadBytes(levels.back());
+    }
+    // Where the payloads after the node table start (level 0's).
     std::uint64_t payloadOffset() const { return nodeTableOffset() + totalNodes * kNodeRecordBytes; }
     std::uint64_t footerOffset() const {
         std::uint64_t end = payloadOffset();
         for (const LevelEntry& level : levels) {
-            end += payloadBytes(level);
+            end += columnar(level) ? 0 : payloadBytes(level);
         }
         return end;
     }
 };
+
+// Sets every level's node-table and payload offsets to where the version's layout puts them,
+// from the counts: the writer's plan, and what a reader expects.
+void assignOffsets(Header& header);
 
 std::uint8_t encodeCollapse(LeafCollapse collapse);
 

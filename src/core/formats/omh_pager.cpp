@@ -186,19 +186,22 @@ void OmhPager::load(int level, std::uint32_t index) {
     const std::size_t begin = node.coveredBegin;
     const std::size_t count = node.pointCount;
     const omh::LevelEntry& entry = m_header.levels[static_cast<std::size_t>(level)];
-    const std::uint64_t offset =
-        entry.payloadOffset +
-        (begin - m_levelFirst[static_cast<std::size_t>(level)]) * m_header.recordBytes;
+    const std::uint64_t inLevel = begin - m_levelFirst[static_cast<std::size_t>(level)];
     m_pages.acquire(begin, begin + count);
     try {
-        m_records.resize(count * m_header.recordBytes);
-        m_stream.seek(offset);
-        const std::string section = omhSectionAt(m_header, offset);
-        m_stream.readExact(m_records.data(), m_records.size(), section);
-        const std::size_t bad = m_decoder.store(m_records.data(), count, begin, node.code, level);
+        std::size_t bad = 0;
+        if (m_header.columnar(entry)) { // version 4's deepest level: a read per column
+            m_decoder.readColumns(m_stream, level, inLevel, count, begin, nullptr);
+            bad = m_decoder.firstMisplaced(begin, count, node.code, level);
+        } else {
+            const std::uint64_t offset = entry.payloadOffset + inLevel * m_header.recordBytes;
+            m_records.resize(count * m_header.recordBytes);
+            m_stream.seek(offset);
+            m_stream.readExact(m_records.data(), m_records.size(), omhSectionAt(m_header, offset));
+            bad = m_decoder.store(m_records.data(), count, begin, node.code, level);
+        }
         if (bad != count) {
-            throw m_decoder.misplaced(
-                level, begin + bad - m_levelFirst[static_cast<std::size_t>(level)], node.code);
+            throw m_decoder.misplaced(level, inLevel + bad, node.code);
         }
         if (!m_header.splatsInRecords() && omh::storesSplats(count)) {
             loadSparseSplats(level, index, node);

@@ -161,7 +161,8 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
                               const SubtreePoints& subtrees, int firstLevel,
                               std::uint64_t maxBatchPoints,
                               const std::function<void(int level)>& afterLevel,
-                              const std::function<void(std::uint64_t readEnd)>& afterRead) {
+                              const std::function<void(std::uint64_t readEnd)>& afterRead,
+                              OmhColumnSink* deepestColumns) {
     const SortedCloud& cloud = hierarchy.cloud();
     const int levelCount = hierarchy.maxLevel() + 1;
     std::vector<OmhRecordSink> sinks;
@@ -190,10 +191,15 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
     const std::size_t slots = cloud.fileBacked() ? 2 : 3;
     std::array<Batch, 3> batches;
     ParallelRecordEncoder encoder(cloud, layout, sinks, firstLevel);
+    const int deepest = levelCount - 1;
     const auto write = [&](const Batch& batch) {
         for (std::size_t b = 0; b < batch.nodes.size(); ++b) {
             const auto [level, index] = batch.nodes[b];
-            encoder.add(level, hierarchy.node(level, index), batch.splats[b]);
+            if (deepestColumns != nullptr && level == deepest) {
+                deepestColumns->addNode(hierarchy.node(level, index), batch.splats[b]);
+            } else {
+                encoder.add(level, hierarchy.node(level, index), batch.splats[b]);
+            }
         }
         encoder.finish(); // before the batch's splats are reused
     };
@@ -273,7 +279,9 @@ void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy
     writing.wait();
     for (int level = firstLevel; level < levelCount; ++level) {
         levels[static_cast<std::size_t>(level)].payloadChecksum =
-            sinks[static_cast<std::size_t>(level - firstLevel)].finishSection();
+            deepestColumns != nullptr && level == deepest
+                ? deepestColumns->finishSection()
+                : sinks[static_cast<std::size_t>(level - firstLevel)].finishSection();
         if (afterLevel) {
             afterLevel(level);
         }

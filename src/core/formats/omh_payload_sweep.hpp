@@ -13,6 +13,7 @@
 #pragma once
 
 #include "build/hierarchy.hpp"
+#include "formats/omh_column_sink.hpp"
 #include "formats/omh_format.hpp"
 #include "io/atomic_file_writer.hpp"
 
@@ -37,11 +38,14 @@ int omhSweepFirstLevel(const SubtreePoints& subtrees, std::uint64_t maxBatchPoin
 // one subtree alone holds more. `afterRead` (may be empty) is called on the calling thread
 // once a batch's stretch of the cloud has been read, with the stretch's end: the points before
 // it are in memory now (a built hierarchy's batches cover the cloud front to back).
+// `deepestColumns` (version 4; null before) takes the deepest level's nodes, stored as
+// columns, in place of its records.
 void writeOmhLevelsInOneSweep(AtomicFileWriter& file, const Hierarchy& hierarchy,
                               const omh::RecordLayout& layout, std::vector<omh::LevelEntry>& levels,
                               const SubtreePoints& subtrees, int firstLevel,
                               std::uint64_t maxBatchPoints,
                               const std::function<void(int level)>& afterLevel,
-                              const std::function<void(std::uint64_t readEnd)>& afterRead);
+                              const std::function<void(std::uint64_t readEnd)>& afterRead,
+                              OmhColumnSink* deepestColumns);
 
 } // namespace omicron

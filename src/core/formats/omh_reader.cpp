@@ -67,8 +67,12 @@ std::string omhSectionAt(const omh::Header& header, std::uint64_t offset) {
     if (offset < omh::kHeaderBytes) {
         return "the header (" + range(0, omh::kHeaderBytes) + ")";
     }
-    if (offset < header.nodeTableOffset()) {
-        return "the level table (" + range(omh::kHeaderBytes, header.nodeTableOffset()) + ")";
+    if (offset < header.levelTableEnd()) {
+        return "the level table (" + range(omh::kHeaderBytes, header.levelTableEnd()) + ")";
+    }
+    if (header.version >= omh::kFirstVersionWithDeepestColumns && offset < header.columnsOffset()) {
+        return "the padding after the level table (" +
+               range(header.levelTableEnd(), header.columnsOffset()) + ")";
     }
     for (std::size_t l = 0; l < header.levels.size(); ++l) {
         const omh::LevelEntry& e = header.levels[l];
@@ -80,7 +84,25 @@ std::string omhSectionAt(const omh::Header& header, std::uint64_t offset) {
     }
     for (std::size_t l = 0; l < header.levels.size(); ++l) {
         const omh::LevelEntry& e = header.levels[l];
-        const std::uint64_t end = e.payloadOffset + e.points * header.recordBytes;
+        const std::uint64_t end = e.payloadOffset + header.recordsBytes(e);
+        if (header.columnar(e) && offset >= e.payloadOffset && offset < end) {
+            const std::vector<omh::Column> columns = header.columns();
+            const std::vector<std::uint64_t> starts = omh::columnStarts(columns, e.points);
+            std::size_t c = columns.size() - 1;
+            while (c > 0 && offset < e.payloadOffset + starts[c]) {
+                --c;
+            }
+            const std::uint64_t begin = e.payloadOffset + starts[c];
+            const std::uint64_t columnEnd = begin + e.points * columns[c].bytes;
+            const std::string column = std::string(omh::columnName(columns[c].kind)) +
+                                       " column of " + levelName(static_cast<int>(l));
+            if (offset >= columnEnd) {
+                const std::uint64_t next =
+                    c + 1 < columns.size() ? e.payloadOffset + starts[c + 1] : end;
+                return "the padding after the " + column + " (" + range(columnEnd, next) + ")";
+            }
+            return "the " + column + " (" + range(begin, columnEnd) + ")";
+        }
         if (offset >= e.payloadOffset && offset < end) {
             return "the point records of " + levelName(static_cast<int>(l)) + " (" +
                    range(e.payloadOffset, end) + ")";
@@ -96,7 +118,12 @@ std::string omhSectionAt(const omh::Header& header, std::uint64_t offset) {
 }
 
 std::string omhPayloadName(const omh::Header& header, const omh::LevelEntry& level) {
-    std::string name = omhSectionAt(header, level.payloadOffset);
+    // A columnar level's checksum covers all its columns: a mismatch cannot say which.
+    std::string name =
+        header.columnar(level)
+            ? "the columns of level " + std::to_string(header.levels.size() - 1) + " (" +
+                  range(level.payloadOffset, level.payloadOffset + header.recordsBytes(level)) + ")"
+            : omhSectionAt(header, level.payloadOffset);
     if (level.sparsePoints > 0) {
         name += " and " + omhSectionAt(header, header.sparseSplatsOffset(level));
     }
@@ -297,7 +324,7 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
                 " for " + range(omh::kHeaderBytes, omh::kHeaderBytes + entryBytes) +
                 ", they hash to " + hexText(tableChecksum) + ": the level table is damaged");
     }
-    info.levels.resize(levelCount);
+    info.setLevelCount(levelCount);
     std::uint64_t nodes = 0, points = 0;
     for (std::size_t l = 0; l < levelCount; ++l) {
         const std::uint8_t* at = table.data() + l * entryStride;
@@ -326,11 +353,6 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
                       " points, " + std::to_string(e.sparsePoints) +
                       " of sparse nodes) do not fit the header's totals and the octree");
         }
-        const std::uint64_t expectedNodeOffset =
-            info.nodeTableOffset() + nodes * omh::kNodeRecordBytes;
-        if (e.nodeTableOffset != expectedNodeOffset) {
-            throw bad("expected the node table at byte " + std::to_string(expectedNodeOffset));
-        }
         nodes += e.nodes;
         points += e.points;
     }
@@ -342,7 +364,7 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
                         std::to_string(info.totalPoints));
     }
     // The totals are bounded by the file size before any offset is computed from them.
-    const std::uint64_t fixed = info.nodeTableOffset() + omh::kFooterBytes;
+    const std::uint64_t fixed = info.levelTableEnd() + omh::kFooterBytes;
     if (fileBytes < fixed || info.totalNodes > (fileBytes - fixed) / omh::kNodeRecordBytes ||
         info.totalPoints >
             (fileBytes - fixed - info.totalNodes * omh::kNodeRecordBytes) / info.recordBytes) {
@@ -353,16 +375,24 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
                         std::to_string(info.totalPoints) + " point records of " +
                         std::to_string(info.recordBytes) + " bytes");
     }
-    std::uint64_t payloadOffset = info.payloadOffset();
+    // Every section where the counts put it (version 4: the deepest level's columns first).
+    omh::Header planned = info;
+    omh::assignOffsets(planned);
     for (std::size_t l = 0; l < levelCount; ++l) {
-        if (info.levels[l].payloadOffset != payloadOffset) {
-            throw error(InputErrorKind::MalformedHeader,
-                        omh::kHeaderBytes + l * entryStride + omh::level::kPayloadOffset,
-                        "in the level table, " + levelName(static_cast<int>(l)) +
-                            ": expected the point records at byte " +
-                            std::to_string(payloadOffset));
+        const auto misplaced = [&](std::size_t field, const std::string& what, std::uint64_t at) {
+            return error(InputErrorKind::MalformedHeader,
+                         omh::kHeaderBytes + l * entryStride + field,
+                         "in the level table, " + levelName(static_cast<int>(l)) + ": expected " +
+                             what + " at byte " + std::to_string(at));
+        };
+        if (info.levels[l].nodeTableOffset != planned.levels[l].nodeTableOffset) {
+            throw misplaced(omh::level::kNodeTableOffset, "the node table",
+                            planned.levels[l].nodeTableOffset);
         }
-        payloadOffset += info.payloadBytes(info.levels[l]);
+        if (info.levels[l].payloadOffset != planned.levels[l].payloadOffset) {
+            throw misplaced(omh::level::kPayloadOffset, "the point records",
+                            planned.levels[l].payloadOffset);
+        }
     }
     const std::uint64_t expectedBytes = info.footerOffset() + omh::kFooterBytes;
     if (fileBytes < expectedBytes) { // version 3: inside a level's sparse splats or the footer
@@ -397,6 +427,37 @@ OmhReader::OmhReader(const std::string& path) : m_stream(path) {
         loadRaw<std::uint64_t>(footer.data() + omh::footer::kTotalPoints) != info.totalPoints) {
         throw error(InputErrorKind::CountMismatch, footerStart + omh::footer::kTotalNodes,
                     "the footer's node and point counts differ from the header's");
+    }
+    if (version >= omh::kFirstVersionWithDeepestColumns) {
+        checkPadding(info.levelTableEnd(), info.columnsOffset());
+    }
+}
+
+void OmhReader::checkPadding(std::uint64_t begin, std::uint64_t end) {
+    std::array<std::uint8_t, omh::kColumnAlignment> bytes{};
+    const std::size_t count = static_cast<std::size_t>(end - begin); // < kColumnAlignment
+    if (m_stream.readAt(begin, bytes.data(), count) != count) {
+        throw InputError(InputErrorKind::Truncated, m_header.path, InputLocation::byte(begin),
+                         "the file ends inside " + omhSectionAt(m_header, begin));
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+        if (bytes[i] != 0) {
+            throw InputError(InputErrorKind::MalformedValue, m_header.path,
+                             InputLocation::byte(begin + i),
+                             "in " + omhSectionAt(m_header, begin + i) +
+                                 ": expected zero bytes, found " + std::to_string(bytes[i]));
+        }
+    }
+}
+
+void OmhReader::checkColumnPadding(const omh::LevelEntry& entry) {
+    const std::vector<omh::Column> columns = m_header.columns();
+    const std::vector<std::uint64_t> starts = omh::columnStarts(columns, entry.points);
+    for (std::size_t c = 0; c < columns.size(); ++c) {
+        const std::uint64_t end =
+            c + 1 < columns.size() ? starts[c + 1] : m_header.recordsBytes(entry);
+        checkPadding(entry.payloadOffset + starts[c] + entry.points * columns[c].bytes,
+                     entry.payloadOffset + end);
     }
 }
 
@@ -559,9 +620,46 @@ std::vector<OctreeNode> OmhReader::readNodes(int level, std::vector<std::uint8_t
     return nodes;
 }
 
+void OmhReader::readColumnarPoints(int level, const std::vector<OctreeNode>& nodes,
+                                   std::uint64_t firstPoint) {
+    const omh::LevelEntry& entry = m_header.levels[static_cast<std::size_t>(level)];
+    const OmhRecordDecoder decoder(m_header, *m_cloud, m_hierarchy->mutableStoredSplats());
+    std::vector<oms::PayloadChecksum> columns(m_header.columns().size());
+    decoder.readColumns(m_stream, level, 0, static_cast<std::size_t>(entry.points),
+                        static_cast<std::size_t>(firstPoint), &columns);
+    oms::PayloadChecksum sparse;
+    readSparseSplats(level, nodes, decoder, sparse);
+    std::vector<std::uint64_t> digests;
+    for (const oms::PayloadChecksum& column : columns) {
+        digests.push_back(column.digest());
+    }
+    digests.push_back(sparse.digest());
+    const std::uint64_t digest = omh::columnarChecksum(digests);
+    if (digest != entry.payloadChecksum) {
+        throw InputError(InputErrorKind::MalformedValue, m_header.path,
+                         InputLocation::byte(entry.payloadOffset),
+                         "checksum mismatch in " + omhPayloadName(m_header, entry) +
+                             ": the level table stores XXH3-64 " + hexText(entry.payloadChecksum) +
+                             ", they hash to " + hexText(digest));
+    }
+    // Checked after the checksum, as the records are: in a damaged file the mismatch is the
+    // better explanation.
+    checkColumnPadding(entry);
+    for (const OctreeNode& node : nodes) {
+        const std::size_t bad =
+            decoder.firstMisplaced(node.coveredBegin, node.pointCount, node.code, level);
+        if (bad != node.pointCount) {
+            throw decoder.misplaced(level, node.coveredBegin + bad - firstPoint, node.code);
+        }
+    }
+}
+
 void OmhReader::readPoints(int level, const std::vector<OctreeNode>& nodes,
                            std::uint64_t firstPoint) {
     const omh::LevelEntry& entry = m_header.levels[static_cast<std::size_t>(level)];
+    if (m_header.columnar(entry)) {
+        return readColumnarPoints(level, nodes, firstPoint);
+    }
     const std::string section = omhSectionAt(m_header, entry.payloadOffset);
     const std::string payload = omhPayloadName(m_header, entry);
     const std::size_t recordBytes = m_layout.bytes;
@@ -619,6 +717,7 @@ void OmhReader::readSparseSplats(int level, const std::vector<OctreeNode>& nodes
         return;
     }
     const std::string section = omhSectionAt(m_header, m_header.sparseSplatsOffset(entry));
+    m_stream.seek(m_header.sparseSplatsOffset(entry)); // a columnar level's are aligned
     const std::size_t splatBytes = m_header.splatBytes();
     const std::size_t blockPoints = kBlockBytes / splatBytes;
     auto node = nodes.begin();
@@ -694,8 +793,8 @@ void OmhReader::load(const LevelCallback& onLevel, const std::atomic<bool>* canc
 }
 
 void OmhReader::verify() {
-    const auto check = [&](std::uint64_t offset, std::uint64_t bytes, std::uint64_t expected,
-                           const std::string& section) {
+    const auto hashRange = [&](std::uint64_t offset, std::uint64_t bytes,
+                               const std::string& section) {
         oms::PayloadChecksum checksum;
         m_stream.seek(offset);
         for (std::uint64_t done = 0; done < bytes;) {
@@ -706,7 +805,11 @@ void OmhReader::verify() {
             checksum.update(m_block.data(), take);
             done += take;
         }
-        const std::uint64_t digest = checksum.digest();
+        return checksum.digest();
+    };
+    const auto check = [&](std::uint64_t offset, std::uint64_t bytes, std::uint64_t expected,
+                           const std::string& section) {
+        const std::uint64_t digest = hashRange(offset, bytes, section);
         if (digest != expected) {
             throw InputError(InputErrorKind::MalformedValue, m_header.path,
                              InputLocation::byte(offset),
@@ -722,8 +825,31 @@ void OmhReader::verify() {
               omhSectionAt(m_header, e.nodeTableOffset));
     }
     for (const omh::LevelEntry& e : m_header.levels) {
-        check(e.payloadOffset, m_header.payloadBytes(e), e.payloadChecksum,
-              omhPayloadName(m_header, e));
+        if (!m_header.columnar(e)) {
+            check(e.payloadOffset, m_header.payloadBytes(e), e.payloadChecksum,
+                  omhPayloadName(m_header, e));
+            continue;
+        }
+        // Each column hashed on its own, then the sparse splat attributes (columnarChecksum).
+        const std::vector<omh::Column> columns = m_header.columns();
+        const std::vector<std::uint64_t> starts = omh::columnStarts(columns, e.points);
+        std::vector<std::uint64_t> digests;
+        for (std::size_t c = 0; c < columns.size(); ++c) {
+            digests.push_back(hashRange(e.payloadOffset + starts[c], e.points * columns[c].bytes,
+                                        omhSectionAt(m_header, e.payloadOffset + starts[c])));
+        }
+        const std::uint64_t sparse = m_header.sparseSplatsOffset(e);
+        digests.push_back(
+            hashRange(sparse, e.sparsePoints * m_header.splatBytes(), omhPayloadName(m_header, e)));
+        const std::uint64_t digest = omh::columnarChecksum(digests);
+        if (digest != e.payloadChecksum) {
+            throw InputError(InputErrorKind::MalformedValue, m_header.path,
+                             InputLocation::byte(e.payloadOffset),
+                             "checksum mismatch in " + omhPayloadName(m_header, e) +
+                                 ": the level table stores XXH3-64 " + hexText(e.payloadChecksum) +
+                                 ", the bytes hash to " + hexText(digest));
+        }
+        checkColumnPadding(e);
     }
 }
 

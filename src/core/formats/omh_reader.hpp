@@ -75,6 +75,14 @@ private:
                                       std::vector<morton::Code>& expectedCodes,
                                       std::uint64_t firstPoint);
     void readPoints(int level, const std::vector<OctreeNode>& nodes, std::uint64_t firstPoint);
+    // Version 4: the bytes [begin, end) (fewer than omh::kColumnAlignment) are zero, or an
+    // InputError names the first that is not.
+    void checkPadding(std::uint64_t begin, std::uint64_t end);
+    // ...and the padding after each column of the columnar level `entry`.
+    void checkColumnPadding(const omh::LevelEntry& entry);
+    // Version 4's deepest level: its columns straight into the cloud.
+    void readColumnarPoints(int level, const std::vector<OctreeNode>& nodes,
+                            std::uint64_t firstPoint);
     // Version 3: the splat attributes of the level's sparse nodes, after its records.
     void readSparseSplats(int level, const std::vector<OctreeNode>& nodes,
                           const OmhRecordDecoder& decoder, oms::PayloadChecksum& checksum);

@@ -4,6 +4,7 @@
 #include "hex_text.hpp"
 #include "io/raw_bytes.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -55,6 +56,72 @@ std::size_t OmhRecordDecoder::store(const std::uint8_t* records, std::size_t cou
     return firstBad;
 }
 
+namespace {
+
+// Where the cloud keeps a column's values, contiguous (a column in the records is not
+// uniform, so the cloud holds one value a point).
+std::uint8_t* columnBase(SortedCloud& cloud, omh::ColumnKind kind) {
+    const auto bytes = [](auto span) {
+        return reinterpret_cast<std::uint8_t*>(span.data());
+    };
+    switch (kind) {
+    case omh::ColumnKind::Position:
+        return bytes(cloud.mutablePositions());
+    case omh::ColumnKind::Normal:
+        return bytes(cloud.mutableNormals());
+    case omh::ColumnKind::Color:
+        return bytes(cloud.mutableColors());
+    case omh::ColumnKind::Intensity:
+        return bytes(cloud.mutableIntensities());
+    case omh::ColumnKind::Las:
+        return bytes(cloud.mutableLasColumn());
+    }
+    return nullptr;
+}
+
+// Columns are read in pieces of at most this many bytes.
+constexpr std::size_t kColumnReadBytes = std::size_t{4} << 20;
+
+} // namespace
+
+void OmhRecordDecoder::readColumns(FileStream& stream, int level, std::uint64_t inLevel,
+                                   std::size_t count, std::size_t point,
+                                   std::vector<oms::PayloadChecksum>* checksums) const {
+    const omh::LevelEntry& entry = m_header.levels[static_cast<std::size_t>(level)];
+    const std::vector<omh::Column> columns = omh::recordColumns(m_layout);
+    const std::vector<std::uint64_t> starts = omh::columnStarts(columns, entry.points);
+    for (std::size_t c = 0; c < columns.size(); ++c) {
+        const std::size_t bytes = columns[c].bytes;
+        const std::uint64_t offset = entry.payloadOffset + starts[c] + inLevel * bytes;
+        std::uint8_t* out = columnBase(m_cloud, columns[c].kind) + point * bytes;
+        stream.seek(offset);
+        const std::string section = omhSectionAt(m_header, offset);
+        for (std::size_t left = count * bytes; left > 0;) {
+            const std::size_t take = std::min(left, kColumnReadBytes);
+            stream.readExact(out, take, section);
+            if (checksums != nullptr) {
+                (*checksums)[c].update(out, take);
+            }
+            out += take;
+            left -= take;
+        }
+    }
+}
+
+std::size_t OmhRecordDecoder::firstMisplaced(std::size_t point, std::size_t count,
+                                             morton::Code nodeCode, int level) const {
+    const int shift = 3 * (morton::kMaxLevel - level);
+    const glm::vec3* positions = m_cloud.positions().data() + point;
+    for (std::size_t r = 0; r < count; ++r) {
+        const glm::vec3 p = positions[r];
+        const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+        if (!finite || (morton::encodeUnit(p.x, p.y, p.z) >> shift) != nodeCode) {
+            return r;
+        }
+    }
+    return count;
+}
+
 void OmhRecordDecoder::storeSparseSplats(const std::uint8_t* bytes, std::size_t count,
                                          std::size_t point) const {
     const std::size_t stride = omh::splatBytes(m_estimatedNormals);
@@ -67,8 +134,11 @@ void OmhRecordDecoder::storeSparseSplats(const std::uint8_t* bytes, std::size_t 
 
 InputError OmhRecordDecoder::misplaced(int level, std::uint64_t recordInLevel,
                                        morton::Code nodeCode) const {
-    const std::uint64_t byte = m_header.levels[static_cast<std::size_t>(level)].payloadOffset +
-                               recordInLevel * m_layout.bytes;
+    const omh::LevelEntry& entry = m_header.levels[static_cast<std::size_t>(level)];
+    // A columnar level's position is in its first column (the positions).
+    const std::uint64_t byte =
+        entry.payloadOffset +
+        recordInLevel * (m_header.columnar(entry) ? sizeof(glm::vec3) : m_layout.bytes);
     return InputError(InputErrorKind::MalformedValue, m_header.path, InputLocation::byte(byte),
                       "in " + omhSectionAt(m_header, byte) + ", record " +
                           std::to_string(recordInLevel) +

@@ -5,12 +5,14 @@
 
 #include "build/stored_splats.hpp"
 #include "formats/omh_format.hpp"
+#include "io/file_stream.hpp"
 #include "io/input_error.hpp"
 #include "points/morton.hpp"
 #include "points/sorted_cloud.hpp"
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 namespace omicron {
 
@@ -30,6 +32,17 @@ public:
     void storeSparseSplats(const std::uint8_t* bytes, std::size_t count, std::size_t point) const;
 
     std::size_t recordBytes() const { return m_layout.bytes; }
+
+    // A columnar level (version 4's deepest): reads its points [inLevel, inLevel + count)
+    // from each of its columns in `stream` straight into the cloud's points [point, ...),
+    // hashing each column's bytes into checksums[column] when `checksums` is given.
+    void readColumns(FileStream& stream, int level, std::uint64_t inLevel, std::size_t count,
+                     std::size_t point, std::vector<oms::PayloadChecksum>* checksums) const;
+    // The first of the cloud's points [point, point + count) whose position is not finite or
+    // lies outside the cell of the node `nodeCode` of `level`, as an offset from `point`;
+    // `count` when they are all good.
+    std::size_t firstMisplaced(std::size_t point, std::size_t count, morton::Code nodeCode,
+                               int level) const;
 
     // The error for record `recordInLevel` of `level` that store() found outside the cell of
     // its node `nodeCode`, naming the file, the byte and the section: both loaders' words.

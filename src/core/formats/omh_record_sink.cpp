@@ -178,19 +178,26 @@ void OmhRecordSink::addNode(const OctreeNode& node, const NodeSplats& splats) {
     addSparseSplats(node, splats);
 }
 
-void OmhRecordSink::addSparseSplats(const OctreeNode& node, const NodeSplats& splats) {
-    if (m_layout.splats || !omh::storesSplats(node.pointCount)) {
+void appendOmhSparseSplats(std::vector<std::uint8_t>& out, const OctreeNode& node,
+                           const NodeSplats& splats, bool estimatedNormal) {
+    if (!omh::storesSplats(node.pointCount)) {
         return;
     }
-    const std::size_t bytes = omh::splatBytes(m_layout.estimatedNormal);
-    const std::size_t at = m_sparseSplats.size();
-    m_sparseSplats.resize(at + node.pointCount * bytes);
-    std::uint8_t* out = m_sparseSplats.data() + at;
-    for (std::uint32_t p = 0; p < node.pointCount; ++p, out += bytes) {
-        storeRaw(out, splats.radii[p]);
-        if (m_layout.estimatedNormal) {
-            storeRaw(out + sizeof(std::uint16_t), splats.normals.empty() ? 0u : splats.normals[p]);
+    const std::size_t bytes = omh::splatBytes(estimatedNormal);
+    const std::size_t at = out.size();
+    out.resize(at + node.pointCount * bytes);
+    std::uint8_t* to = out.data() + at;
+    for (std::uint32_t p = 0; p < node.pointCount; ++p, to += bytes) {
+        storeRaw(to, splats.radii[p]);
+        if (estimatedNormal) {
+            storeRaw(to + sizeof(std::uint16_t), splats.normals.empty() ? 0u : splats.normals[p]);
         }
+    }
+}
+
+void OmhRecordSink::addSparseSplats(const OctreeNode& node, const NodeSplats& splats) {
+    if (!m_layout.splats) {
+        appendOmhSparseSplats(m_sparseSplats, node, splats, m_layout.estimatedNormal);
     }
 }
 

@@ -26,6 +26,11 @@ void encodeOmhRecords(const SortedCloud& cloud, const omh::RecordLayout& layout,
                       const OctreeNode& node, const NodeSplats& splats, std::uint32_t first,
                       std::uint32_t last, std::uint8_t* out);
 
+// Appends the splat attributes of `node`'s points to `out` (omh::splatBytes each, as a
+// version 3 level stores them after its records) when it is a sparse node; nothing otherwise.
+void appendOmhSparseSplats(std::vector<std::uint8_t>& out, const OctreeNode& node,
+                           const NodeSplats& splats, bool estimatedNormal);
+
 class OmhRecordSink {
 public:
     // Appends to `file`.

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <optional>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <vector>
@@ -187,14 +188,14 @@ void writeTopLevelsFromCopy(AtomicFileWriter& file, const Hierarchy& hierarchy,
 
 } // namespace
 
-void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::BuildInfo& build,
-              const OmhWriteOptions& options) {
+OmhSaveReport writeOmh(const std::string& path, const Hierarchy& hierarchy,
+                       const omh::BuildInfo& build, const OmhWriteOptions& options) {
     AtomicFileWriter file(path);
-    writeOmh(file, hierarchy, build, options);
+    return writeOmh(file, hierarchy, build, options);
 }
 
-void writeOmh(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::BuildInfo& build,
-              const OmhWriteOptions& options) {
+OmhSaveReport writeOmh(AtomicFileWriter& file, const Hierarchy& hierarchy,
+                       const omh::BuildInfo& build, const OmhWriteOptions& options) {
     const auto fail = [&](const std::string& what) {
         throw OutputError(file.targetPath() + ": " + what);
     };
@@ -209,7 +210,7 @@ void writeOmh(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::Bui
         // Its points were never all in memory: they are in the .omh it was opened from, and
         // loading a .omh and saving it again gives the same bytes, so the file is the save.
         copyPagedSource(file, paged->backingFile());
-        return;
+        return {};
     }
     const SortedCloud& cloud = hierarchy.cloud();
     omh::Header header;
@@ -217,18 +218,17 @@ void writeOmh(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::Bui
     header.attributes = cloud.attributes();
     header.estimatedNormals = hierarchy.estimatesNormals();
     // Uniform columns go into the header once instead of into every record.
-    if (cloud.uniformIntensities()) {
-        header.uniformColumns |= omh::kUniformIntensityBit;
+    header.uniformColumns = omhUniformColumns(cloud);
+    if ((header.uniformColumns & omh::kUniformIntensityBit) != 0) {
         header.uniformIntensity = cloud.intensities()[0];
     }
-    const std::size_t lasBytes = header.attributes.lasBytes();
-    if (cloud.uniformLasColumn() && lasBytes <= omh::kMaxUniformLasBytes) {
-        header.uniformColumns |= omh::kUniformLasBit;
-        header.uniformLasRecord.assign(cloud.lasRecord(0), cloud.lasRecord(0) + lasBytes);
+    if ((header.uniformColumns & omh::kUniformLasBit) != 0) {
+        header.uniformLasRecord.assign(cloud.lasRecord(0),
+                                       cloud.lasRecord(0) + header.attributes.lasBytes());
     }
-    if (options.formatVersion != omh::kVersion && options.formatVersion != 2) {
+    if (options.formatVersion < 2 || options.formatVersion > omh::kVersion) {
         fail("cannot write .omh format version " + std::to_string(options.formatVersion) +
-             " (version 2 or " + std::to_string(omh::kVersion) + ")");
+             " (version 2 to " + std::to_string(omh::kVersion) + ")");
     }
     header.version = options.formatVersion;
     const omh::RecordLayout layout = omh::RecordLayout::of(
@@ -237,7 +237,7 @@ void writeOmh(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::Bui
     header.cube = cloud.cube();
     header.sourceOffset = cloud.sourceOffset();
     const int levels = hierarchy.maxLevel() + 1;
-    header.levels.resize(static_cast<std::size_t>(levels));
+    header.setLevelCount(static_cast<std::size_t>(levels));
     for (int level = 0; level < levels; ++level) {
         omh::LevelEntry& entry = header.levels[static_cast<std::size_t>(level)];
         entry.nodes = hierarchy.nodeCount(level);
@@ -256,14 +256,7 @@ void writeOmh(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::Bui
         fail("the hierarchy has " + std::to_string(header.levels[0].nodes) +
              " nodes at level 0, expected the root alone");
     }
-    std::uint64_t nodeOffset = header.nodeTableOffset();
-    std::uint64_t payloadOffset = header.payloadOffset();
-    for (omh::LevelEntry& entry : header.levels) {
-        entry.nodeTableOffset = nodeOffset;
-        entry.payloadOffset = payloadOffset;
-        nodeOffset += entry.nodes * omh::kNodeRecordBytes;
-        payloadOffset += header.payloadBytes(entry);
-    }
+    omh::assignOffsets(header);
 
     const auto headerBytes = omh::encodeHeader(header);
     file.write(headerBytes.data(), headerBytes.size());
@@ -272,6 +265,14 @@ void writeOmh(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::Bui
     const std::vector<std::uint8_t> placeholder(
         omh::encodeLevelTable(header.levels, header.version).size(), 0);
     file.write(placeholder.data(), placeholder.size());
+    // Version 4: the deepest level's columns (streamed during the build, or written by the
+    // sweep) lie between the level table and the node table, from the next 4096-byte
+    // boundary; the padding before them is zeros.
+    if (header.version >= omh::kFirstVersionWithDeepestColumns) {
+        const std::vector<std::uint8_t> padding(header.columnsOffset() - header.levelTableEnd(), 0);
+        file.write(padding.data(), padding.size());
+    }
+    file.extendTo(header.nodeTableOffset());
 
     std::vector<std::uint8_t> records;
     std::uint64_t firstPoint = 0;
@@ -334,13 +335,17 @@ void writeOmh(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::Bui
     }
     const std::unique_ptr<TopLevelPoints> top =
         gather && firstSweptLevel > 0 ? TopLevelPoints::plan(hierarchy, firstSweptLevel) : nullptr;
-    const omh::LevelEntry& deepest = header.levels.back();
-    const std::uint64_t payloadEnd = deepest.payloadOffset + header.payloadBytes(deepest);
+    const std::uint64_t payloadEnd = header.footerOffset();
+    std::optional<OmhColumnSink> deepestColumns;
+    if (header.columnar(header.levels.back())) {
+        deepestColumns.emplace(file, hierarchy, header, levels - 1, options.streamedColumns);
+    }
+    OmhColumnSink* const columns = deepestColumns ? &*deepestColumns : nullptr;
     if (top) {
         file.extendTo(payloadEnd);
-        writeOmhLevelsInOneSweep(file, hierarchy, layout, header.levels, subtrees, firstSweptLevel,
-                                 sweepBatch, options.afterLevel,
-                                 [&](std::uint64_t readEnd) { top->copyUpTo(readEnd); });
+        writeOmhLevelsInOneSweep(
+            file, hierarchy, layout, header.levels, subtrees, firstSweptLevel, sweepBatch,
+            options.afterLevel, [&](std::uint64_t readEnd) { top->copyUpTo(readEnd); }, columns);
         top->finish();
         writeTopLevelsFromCopy(file, hierarchy, *top, layout, header.levels, firstSweptLevel,
                                options.afterLevel);
@@ -360,7 +365,7 @@ void writeOmh(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::Bui
         }
         file.extendTo(payloadEnd);
         writeOmhLevelsInOneSweep(file, hierarchy, layout, header.levels, subtrees, firstSweptLevel,
-                                 sweepBatch, options.afterLevel, nullptr);
+                                 sweepBatch, options.afterLevel, nullptr, columns);
     }
 
     const auto footerBytes = omh::encodeFooter(header.totalNodes, header.totalPoints);
@@ -368,7 +373,19 @@ void writeOmh(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::Bui
     const std::vector<std::uint8_t> levelTable =
         omh::encodeLevelTable(header.levels, header.version);
     file.writeAt(header.levelTableOffset(), levelTable.data(), levelTable.size());
+    if (options.streamedColumns != nullptr) {
+        // A stream sized for more points than the level holds left more file than it needs.
+        file.truncateTo(file.bytesWritten());
+    }
     file.commit();
+    OmhSaveReport report;
+    if (deepestColumns && deepestColumns->usesStreamed()) {
+        const omh::LevelEntry& deepest = header.levels.back();
+        for (const omh::Column& column : header.columns()) {
+            report.streamedBytesUsed += deepest.points * column.bytes;
+        }
+    }
+    return report;
 }
 
 } // namespace omicron

@@ -5,6 +5,7 @@
 #include "build/build_options.hpp"
 #include "build/build_statistics.hpp"
 #include "build/hierarchy.hpp"
+#include "formats/omh_column_sink.hpp"
 #include "formats/omh_format.hpp"
 #include "io/atomic_file_writer.hpp"
 
@@ -27,9 +28,20 @@ struct OmhWriteOptions {
     // the file and write them afterwards (omh_top_levels.hpp) rather than read them in place.
     // The bytes written do not depend on it; tests turn it off.
     bool gatherTopLevels = true;
-    // The format version written: omh::kVersion, or 2 (every record with its splat
-    // attributes, for readers older than version 3).
+    // The format version written: omh::kVersion; 3 (every level as records, for readers
+    // older than version 4); or 2 (every record with its splat attributes, for readers older
+    // than version 3).
     std::uint32_t formatVersion = omh::kVersion;
+    // Version 4: the deepest level's columns, already in the file where a build streamed them
+    // (omh_column_stream.hpp); used when they are what the level holds, else written over.
+    const OmhStreamedColumns* streamedColumns = nullptr;
+};
+
+// What a save did beyond its bytes.
+struct OmhSaveReport {
+    // Bytes of the deepest level's columns taken as OmhWriteOptions::streamedColumns wrote
+    // them (0: none given, or written again because they were not what the level holds).
+    std::uint64_t streamedBytesUsed = 0;
 };
 
 // The header fields a build determines: its parameters and counts.
@@ -43,11 +55,11 @@ omh::BuildInfo omhBuildInfo(const BuildOptions& options, const BuildStatistics& 
 // A hierarchy whose points are paged in on demand (Hierarchy::residency()) is saved as a copy
 // of the .omh it reads them from (the same bytes, as above; `build` is its header's and
 // afterLevel is not called); an unreadable source is an InputError naming it.
-void writeOmh(const std::string& path, const Hierarchy& hierarchy, const omh::BuildInfo& build,
-              const OmhWriteOptions& options = {});
+OmhSaveReport writeOmh(const std::string& path, const Hierarchy& hierarchy,
+                       const omh::BuildInfo& build, const OmhWriteOptions& options = {});
 // The same into `file`, opened before the hierarchy was built (a target that cannot be written
 // fails before any work), which it commits.
-void writeOmh(AtomicFileWriter& file, const Hierarchy& hierarchy, const omh::BuildInfo& build,
-              const OmhWriteOptions& options = {});
+OmhSaveReport writeOmh(AtomicFileWriter& file, const Hierarchy& hierarchy,
+                       const omh::BuildInfo& build, const OmhWriteOptions& options = {});
 
 } // namespace omicron

@@ -54,6 +54,17 @@ public:
     // memory serially, before the writers could).
     void extendTo(std::uint64_t size);
 
+    // Cuts the file to `size` bytes (size <= bytesWritten()): for a file another descriptor
+    // (openDirect) made longer than what it finally holds. write() continues at `size`.
+    void truncateTo(std::uint64_t size);
+
+    // A second descriptor of the temporary file for direct I/O (O_DIRECT: writes bypass the
+    // page cache; offsets, lengths and buffers aligned to kDirectAlignment), for a region
+    // that a thread of its own fills; the caller closes it. -1 where the file system refuses
+    // direct I/O (a tmpfs).
+    int openDirect() const;
+    static constexpr std::size_t kDirectAlignment = 4096;
+
     // For regions filled with writeAt: starts writing [offset, offset + count) back to disk
     // (and has the disk persist what it holds of the file: io/file_flusher.hpp), or waits for
     // that and drops it from the page cache (io/write_behind.hpp).

@@ -21,11 +21,14 @@
 namespace omicron::test {
 namespace {
 
-std::string saveBuilt(const TempDir& dir, const SyntheticCloud& cloud, int depth) {
+std::string saveBuilt(const TempDir& dir, const SyntheticCloud& cloud, int depth,
+                      std::uint32_t formatVersion = omh::kVersion) {
     const BuildResult built = buildSynthetic(cloud, checkedOptions(depth, LeafCollapse::Off));
     const std::string path = dir.file("paged.omh");
+    OmhWriteOptions options;
+    options.formatVersion = formatVersion;
     writeOmh(path, built.builder->hierarchy(),
-             omhBuildInfo(built.builder->options(), built.builder->statistics()));
+             omhBuildInfo(built.builder->options(), built.builder->statistics()), options);
     return path;
 }
 
@@ -276,15 +279,29 @@ TEST(OmhPagedLoad, AFrontMovingEveryFrameKeepsItsInvariantsWhileTheLoaderReads) 
     EXPECT_GT(paged->residency()->stats().loads, 0u);
 }
 
-TEST(OmhPagedLoad, UnreadableRecordsFailTheirNodeOnlyAndTheParentStaysDrawn) {
+// Version 3 stores the deepest level's records last, version 4 its columns first.
+class OmhPagedDamage : public ::testing::TestWithParam<std::uint32_t> {};
+INSTANTIATE_TEST_SUITE_P(Versions, OmhPagedDamage, ::testing::Values(3u, 4u));
+
+TEST_P(OmhPagedDamage, UnreadableRecordsFailTheirNodeOnlyAndTheParentStaysDrawn) {
     TempDir dir;
-    const std::string path = saveBuilt(dir, makeCloud(Shape::Random, 30000, 14), 5);
+    const std::string path = saveBuilt(dir, makeCloud(Shape::Random, 30000, 14), 5, GetParam());
     OmhReader reader(path);
     const auto paged = openPaged(reader, std::uint64_t{1} << 30);
     // The file loses its deepest level's records after it was opened (a disk unmounted, a
-    // file replaced): those nodes cannot be read.
+    // file replaced): those nodes cannot be read. Version 3: the file ends where they start;
+    // version 4: its columns (before the node table) are overwritten with NaNs.
     const omh::Header& header = reader.header();
-    std::filesystem::resize_file(path, header.levels.back().payloadOffset);
+    const omh::LevelEntry& deepest = header.levels.back();
+    ASSERT_EQ(header.columnar(deepest), GetParam() >= 4u);
+    if (header.columnar(deepest)) {
+        std::vector<std::uint8_t> bytes = readBytes(path);
+        std::fill_n(bytes.begin() + static_cast<std::ptrdiff_t>(deepest.payloadOffset),
+                    header.recordsBytes(deepest), std::uint8_t{0xff});
+        writeBytes(path, bytes);
+    } else {
+        std::filesystem::resize_file(path, deepest.payloadOffset);
+    }
     Front front(paged);
     settlePaged(front, lookingAt({0.5, 0.5, 0.5}, 0.5, 1e9), fullDetail());
     const ResidencyStats stats = paged->residency()->stats();

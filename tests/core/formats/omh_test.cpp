@@ -106,10 +106,11 @@ void expectSameHierarchy(const Hierarchy& built, const Hierarchy& loaded) {
 }
 
 // Build, save, load, compare, save again: the second file must equal the first.
-void expectRoundTrip(const BuildResult& built, const TempDir& dir) {
+void expectRoundTrip(const BuildResult& built, const TempDir& dir,
+                     std::uint32_t formatVersion = omh::kVersion) {
     const std::string first = dir.file("first.omh");
     const std::string second = dir.file("second.omh");
-    save(first, built);
+    save(first, built, formatVersion);
     OmhReader reader(first);
     const auto loaded = reader.hierarchy();
     reader.load();
@@ -124,7 +125,9 @@ void expectRoundTrip(const BuildResult& built, const TempDir& dir) {
         EXPECT_EQ(header.levels[level].leaves, stats.levels[level].leaves);
         EXPECT_EQ(header.levels[level].points, stats.levels[level].points);
     }
-    writeOmh(second, *loaded, header.build);
+    OmhWriteOptions again;
+    again.formatVersion = formatVersion;
+    writeOmh(second, *loaded, header.build, again);
     EXPECT_EQ(readBytes(first), readBytes(second)) << "loading and saving again changed bytes";
 }
 
@@ -284,24 +287,58 @@ struct SmallFile {
     std::vector<std::uint8_t> bytes;
     omh::Header header;
 
-    SmallFile() {
-        save(path, buildSynthetic(makeCloud(Shape::Random, 60, 11), options(2, LeafCollapse::Off)));
+    explicit SmallFile(std::uint32_t version = omh::kVersion) {
+        save(path, buildSynthetic(makeCloud(Shape::Random, 60, 11), options(2, LeafCollapse::Off)),
+             version);
         bytes = readBytes(path);
         header = OmhReader(path).header();
     }
 
-    // The words an error about byte `offset` must contain.
-    std::string sectionName(std::uint64_t offset) const {
+    // The words an error about byte `offset` must contain: a damaged byte, or (`cut`) the
+    // file's end.
+    std::string sectionName(std::uint64_t offset, bool cut = false) const {
         if (offset < omh::kHeaderBytes) {
             return "header";
         }
-        if (offset < header.nodeTableOffset()) {
+        const std::uint64_t tableEnd = omh::kHeaderBytes + header.levels.size() * 64 + 8;
+        if (offset < tableEnd) {
             return "level table";
         }
         if (offset >= header.footerOffset()) {
             return "footer";
         }
+        if (header.version >= 4) { // the deepest level's columns, each from a 4096-byte boundary
+            if (offset < 4096) {
+                return "padding after the level table";
+            }
+            const omh::LevelEntry& deepest = header.levels.back();
+            const std::uint64_t points = deepest.points;
+            // Positions (12 bytes a point) from 4096, then colours (3 bytes) from the next
+            // boundary, then the sparse splat attributes from the one after.
+            const std::uint64_t colors = (4096 + points * 12 + 4095) / 4096 * 4096;
+            const std::uint64_t sparse = (colors + points * 3 + 4095) / 4096 * 4096;
+            const std::string level = " of level " + std::to_string(header.levels.size() - 1);
+            // A damaged byte in a column fails the level's checksum, which covers them all.
+            if (offset < 4096 + points * 12) {
+                return cut ? "position column" + level : "columns" + level;
+            }
+            if (offset < colors) {
+                return "padding after the position column" + level;
+            }
+            if (offset < colors + points * 3) {
+                return cut ? "colour column" + level : "columns" + level;
+            }
+            if (offset < sparse) {
+                return "padding after the colour column" + level;
+            }
+            if (offset < sparse + deepest.sparsePoints * 6) {
+                return "sparse nodes' splat attributes" + level;
+            }
+        }
         for (std::size_t l = header.levels.size(); l-- > 0;) {
+            if (header.columnar(header.levels[l])) {
+                continue;
+            }
             if (offset >= header.sparseSplatsOffset(header.levels[l])) {
                 // A damaged byte here fails the level's checksum, which names both parts.
                 return "sparse nodes' splat attributes of level " + std::to_string(l);
@@ -448,7 +485,7 @@ TEST(OmhVersion3, StoresSplatAttributesOnlyForSparseNodesAndLoadsTheBuildsBitFor
         const SyntheticCloud cloud = makeCloud(Shape::Plane, 20000, 17, normals);
         const BuildResult built = buildSynthetic(cloud, options(5, {}));
         const Hierarchy& hierarchy = built.builder->hierarchy();
-        ASSERT_NO_FATAL_FAILURE(expectRoundTrip(built, dir));
+        ASSERT_NO_FATAL_FAILURE(expectRoundTrip(built, dir, 3));
         const omh::Header header = OmhReader(dir.file("first.omh")).header();
         EXPECT_EQ(header.version, 3u);
         EXPECT_FALSE(header.splatsInRecords());
@@ -517,7 +554,7 @@ TEST(OmhVersion3, AVersion2FileStillLoadsWithTheSplatAttributesItsRecordsCarry) 
 }
 
 TEST(OmhVersion3, ASparseNodeCountThatDisagreesWithTheNodeTableIsAClearError) {
-    SmallFile file;
+    SmallFile file(3);
     std::size_t level = 0;
     while (level < file.header.levels.size() && file.header.levels[level].sparsePoints == 0) {
         ++level;
@@ -535,7 +572,7 @@ TEST(OmhVersion3, ASparseNodeCountThatDisagreesWithTheNodeTableIsAClearError) {
     const std::uint64_t cut = file.header.sparseSplatsOffset(file.header.levels[level]);
     bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(cut),
                 bytes.begin() + static_cast<std::ptrdiff_t>(cut + file.header.splatBytes()));
-    putLevelTable(bytes, levels, omh::kVersion);
+    putLevelTable(bytes, levels, 3);
     const std::string bad = file.dir.file("bad.omh");
     writeBytes(bad, bytes);
     const std::string message = loadError(bad);
@@ -563,14 +600,19 @@ TEST(OmhUniformColumns, BadUniformFieldsAreClearErrors) {
     expectError(withHeaderByte(plain, omh::header::kUniformColumns, omh::kUniformLasBit),
                 "a uniform LAS column is declared");
     expectError(withHeaderByte(plain, omh::header::kReserved2, 1), "reserved zero byte");
-    expectError(withHeaderByte(plain, omh::header::kVersion, 4), "format version 1 to 3, found 4");
+    expectError(withHeaderByte(plain, omh::header::kVersion, 5), "format version 1 to 4, found 5");
     // The uniform LAS record ends at byte 134 + 16: a byte after it must be zero.
     expectError(withHeaderByte(uniform, omh::header::kUniformLasRecord + 16, 9),
                 "expected reserved bytes 150-247 to be zero");
 }
 
-TEST(OmhDamage, EveryByteFlipIsDetectedAndNamesTheSection) {
-    SmallFile file;
+// Each version's layout: 3 stores every level as records, 4 the deepest as columns first.
+class OmhDamage : public ::testing::TestWithParam<std::uint32_t> {};
+INSTANTIATE_TEST_SUITE_P(Versions, OmhDamage, ::testing::Values(3u, 4u));
+
+TEST_P(OmhDamage, EveryByteFlipIsDetectedAndNamesTheSection) {
+    SmallFile file(GetParam());
+    ASSERT_EQ(file.header.version, GetParam());
     ASSERT_GT(file.header.levels[2].points, 0u);
     const std::string damaged = file.dir.file("damaged.omh");
     for (std::size_t at = 0; at < file.bytes.size(); ++at) {
@@ -585,8 +627,8 @@ TEST(OmhDamage, EveryByteFlipIsDetectedAndNamesTheSection) {
     }
 }
 
-TEST(OmhDamage, VerifyFindsAFlipThatOpeningDoesNotRead) {
-    SmallFile file;
+TEST_P(OmhDamage, VerifyFindsAFlipThatOpeningDoesNotRead) {
+    SmallFile file(GetParam());
     std::vector<std::uint8_t> bytes = file.bytes;
     bytes[file.header.levels[2].payloadOffset + 1] ^= 1;
     writeBytes(file.path, bytes);
@@ -595,13 +637,15 @@ TEST(OmhDamage, VerifyFindsAFlipThatOpeningDoesNotRead) {
         reader.verify();
         FAIL() << "verify() missed the damaged point records";
     } catch (const InputError& error) {
-        EXPECT_NE(std::string(error.what()).find("point records of level 2"), std::string::npos)
+        EXPECT_NE(std::string(error.what())
+                      .find(file.sectionName(file.header.levels[2].payloadOffset + 1)),
+                  std::string::npos)
             << error.what();
     }
 }
 
-TEST(OmhDamage, TruncationAtEverySectionBoundaryIsAClearError) {
-    SmallFile file;
+TEST_P(OmhDamage, TruncationAtEverySectionBoundaryIsAClearError) {
+    SmallFile file(GetParam());
     std::vector<std::uint64_t> boundaries{1, omh::kHeaderBytes, file.header.nodeTableOffset(),
                                           file.header.footerOffset(), file.bytes.size() - 1};
     for (const omh::LevelEntry& level : file.header.levels) {
@@ -621,7 +665,7 @@ TEST(OmhDamage, TruncationAtEverySectionBoundaryIsAClearError) {
             const std::string message = error.what();
             EXPECT_EQ(error.kind(), InputErrorKind::Truncated) << message;
             EXPECT_NE(message.find(cut), std::string::npos) << message;
-            EXPECT_NE(message.find(file.sectionName(size)), std::string::npos)
+            EXPECT_NE(message.find(file.sectionName(size, true)), std::string::npos)
                 << "cut at " << size << ": " << message;
         }
     }
@@ -634,8 +678,8 @@ TEST(OmhDamage, TruncationAtEverySectionBoundaryIsAClearError) {
     }
 }
 
-TEST(OmhDamage, TrailingBytesAreACountMismatch) {
-    SmallFile file;
+TEST_P(OmhDamage, TrailingBytesAreACountMismatch) {
+    SmallFile file(GetParam());
     std::vector<std::uint8_t> bytes = file.bytes;
     bytes.push_back(0);
     writeBytes(file.path, bytes);

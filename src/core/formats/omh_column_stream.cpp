@@ -1,0 +1,239 @@
+#include "formats/omh_column_stream.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <fcntl.h>
+#include <new>
+#include <system_error>
+#include <unistd.h>
+
+namespace omicron {
+
+namespace {
+
+// Each write moves at most this much (the device's queue takes it in pieces anyway).
+constexpr std::uint64_t kWriteBytes = std::uint64_t{4} << 20;
+// How long the thread sleeps when it has caught up with the sorted prefix: the sorter
+// publishes chunks of hundreds of thousands of points, so a millisecond late costs nothing.
+constexpr auto kPollInterval = std::chrono::milliseconds(1);
+constexpr std::uint64_t kAlign = AtomicFileWriter::kDirectAlignment;
+
+std::uint64_t columnsOffsetFor(int maxLevel) {
+    omh::Header header;
+    header.version = omh::kFirstVersionWithDeepestColumns;
+    header.setLevelCount(static_cast<std::size_t>(maxLevel) + 1);
+    return header.columnsOffset();
+}
+
+// The cloud's array that is `column` as the file stores it; null where there is none.
+const std::uint8_t* cloudColumn(const SortedCloud& cloud, const omh::Column& column) {
+    const omh::ColumnKind kind = column.kind;
+    const auto bytes = [](auto span) {
+        return span.empty() ? nullptr : reinterpret_cast<const std::uint8_t*>(span.data());
+    };
+    switch (kind) {
+    case omh::ColumnKind::Position:
+        return bytes(cloud.positions());
+    case omh::ColumnKind::Normal:
+        return bytes(cloud.normals());
+    case omh::ColumnKind::Color:
+        return bytes(cloud.colors());
+    case omh::ColumnKind::Intensity: // in the records: not uniform, one value a point
+        return reinterpret_cast<const std::uint8_t*>(cloud.intensities().data);
+    case omh::ColumnKind::Las: // uniform but too long for the header: one record for all
+        return cloud.lasColumn().stride == column.bytes ? cloud.lasColumn().data : nullptr;
+    }
+    return nullptr;
+}
+
+} // namespace
+
+OmhColumnStream::OmhColumnStream(AtomicFileWriter& file, int maxLevel,
+                                 std::function<std::shared_ptr<const SortedCloud>()> cloud)
+    : m_file(file), m_offset(columnsOffsetFor(maxLevel)), m_source(std::move(cloud)) {
+    m_thread = std::thread([this] { run(); });
+}
+
+OmhColumnStream::~OmhColumnStream() {
+    m_abandon.store(true);
+    if (m_thread.joinable()) {
+        m_thread.join();
+    }
+    if (m_direct >= 0) {
+        ::close(m_direct);
+    }
+}
+
+OmhStreamedColumns OmhColumnStream::finish() {
+    m_finishing.store(true);
+    m_thread.join();
+    if (m_direct >= 0) { // the file has one descriptor again, as any save's
+        ::close(m_direct);
+        m_direct = -1;
+    }
+    if (m_error) {
+        std::rethrow_exception(m_error);
+    }
+    if (!m_streaming) {
+        return {};
+    }
+    for (const oms::PayloadChecksum& checksum : m_checksums) {
+        m_written.digests.push_back(checksum.digest());
+    }
+    return std::move(m_written);
+}
+
+void OmhColumnStream::run() {
+    try {
+        while (!m_abandon.load()) {
+            // Read before the cloud's end: once the build is over (finishing), the end read
+            // after it is the final one, and everything up to it gets written before stopping.
+            const bool finishing = m_finishing.load();
+            if (!m_cloud) {
+                // The uniform columns are declared before the first point is published: the
+                // record layout is known once a point is (or the cloud is complete, empty).
+                std::shared_ptr<const SortedCloud> cloud = m_source();
+                if (cloud && (cloud->sortedEnd() > 0 || cloud->complete())) {
+                    m_cloud = std::move(cloud);
+                    if (!start(*m_cloud)) {
+                        return; // not streamed: writeOmh writes the columns
+                    }
+                }
+            }
+            if (!m_cloud) {
+                if (finishing) {
+                    return;
+                }
+                std::this_thread::sleep_for(kPollInterval);
+                continue;
+            }
+            const bool complete = m_cloud->complete();
+            const std::size_t end = m_cloud->sortedEnd();
+            if (complete && end != m_written.points) {
+                m_streaming = false; // not the count announced: writeOmh writes the columns
+                return;
+            }
+            bool wrote = false;
+            for (std::size_t c = 0; c < m_written.columns.size(); ++c) {
+                const std::uint64_t bytes = std::uint64_t{end} * m_written.columns[c].bytes;
+                const std::uint64_t target = complete ? bytes : bytes / kAlign * kAlign;
+                if (target > m_done[c]) {
+                    writeColumn(c, target);
+                    wrote = true;
+                }
+            }
+            if (complete) {
+                return; // every column written to its end
+            }
+            if (!wrote) {
+                if (finishing) {
+                    return; // a build that ended without completing the cloud
+                }
+                std::this_thread::sleep_for(kPollInterval);
+            }
+        }
+    } catch (...) {
+        m_error = std::current_exception();
+    }
+}
+
+bool OmhColumnStream::start(const SortedCloud& cloud) {
+    if (cloud.fileBacked() || cloud.order() != CloudOrder::Morton) {
+        return false;
+    }
+    const omh::RecordLayout layout =
+        omh::RecordLayout::of(cloud.attributes(), !cloud.attributes().has(Attribute::Normal),
+                              omhUniformColumns(cloud), omh::kFirstVersionWithDeepestColumns);
+    m_written.columns = omh::recordColumns(layout);
+    for (const omh::Column& column : m_written.columns) {
+        m_data.push_back(cloudColumn(cloud, column));
+        if (m_data.back() == nullptr) {
+            return false; // the packed store
+        }
+    }
+    m_direct = m_file.openDirect();
+    if (m_direct < 0) {
+        return false;
+    }
+    m_written.cloud = &cloud;
+    m_written.offset = m_offset;
+    m_written.points = cloud.capacity();
+    m_starts = omh::columnStarts(m_written.columns, m_written.points);
+    m_done.assign(m_written.columns.size(), 0);
+    m_checksums = std::vector<oms::PayloadChecksum>(m_written.columns.size());
+    m_tail.reset(static_cast<std::uint8_t*>(std::aligned_alloc(kAlign, kAlign)));
+    if (!m_tail) {
+        throw std::bad_alloc();
+    }
+    // The whole region's room at once: a full disk fails here, before the build has gone far.
+    // (It makes the file that long; writeOmh cuts it to what it finally holds.)
+    if (::fallocate(m_direct, 0, static_cast<off_t>(m_offset),
+                    static_cast<off_t>(m_starts.back())) != 0 &&
+        (errno == ENOSPC || errno == EDQUOT)) {
+        fail("no room for the " + std::to_string(m_offset + m_starts.back()) +
+                 " bytes of the deepest level",
+             errno);
+    }
+    m_streaming = true;
+    return true;
+}
+
+void OmhColumnStream::writeColumn(std::size_t c, std::uint64_t end) {
+    const std::uint8_t* data = m_data[c];
+    const std::uint64_t base = m_offset + m_starts[c];
+    while (m_done[c] < end && !m_abandon.load()) {
+        const std::uint64_t whole = (end - m_done[c]) / kAlign * kAlign;
+        const std::uint64_t count = std::min(whole, kWriteBytes);
+        const std::uint8_t* bytes = data + m_done[c];
+        if (count == 0) {
+            // The column's last, partial block, from an aligned copy padded with zeros (the
+            // padding before the next column, or bytes writeOmh writes after this).
+            const std::uint64_t rest = end - m_done[c];
+            std::memset(m_tail.get(), 0, kAlign);
+            std::memcpy(m_tail.get(), bytes, rest);
+            m_checksums[c].update(bytes, rest);
+            if (::pwrite(m_direct, m_tail.get(), kAlign, static_cast<off_t>(base + m_done[c])) !=
+                static_cast<ssize_t>(kAlign)) {
+                fail("cannot write the deepest level's " +
+                         std::string(omh::columnName(m_written.columns[c].kind)) + " column",
+                     errno);
+            }
+            m_done[c] = end;
+            m_bytesWritten.fetch_add(rest, std::memory_order_relaxed);
+            break;
+        }
+        m_checksums[c].update(bytes, count);
+        std::uint64_t written = 0;
+        while (written < count) {
+            const ssize_t n = ::pwrite(m_direct, bytes + written, count - written,
+                                       static_cast<off_t>(base + m_done[c] + written));
+            if (n < 0 && errno == EINTR) {
+                continue;
+            }
+            if (n < 0 && errno == EINVAL) {
+                // Direct I/O refused after all (an alignment the device needs beyond the
+                // page's): nothing is streamed, writeOmh writes the columns.
+                m_streaming = false;
+                m_abandon.store(true);
+                return;
+            }
+            if (n <= 0) {
+                fail("cannot write the deepest level's " +
+                         std::string(omh::columnName(m_written.columns[c].kind)) + " column",
+                     n < 0 ? errno : EIO);
+            }
+            written += static_cast<std::uint64_t>(n);
+        }
+        m_done[c] += count;
+        m_bytesWritten.fetch_add(count, std::memory_order_relaxed);
+    }
+}
+
+void OmhColumnStream::fail(const std::string& what, int error) const {
+    throw OutputError(m_file.targetPath() + ": " + what + ": " +
+                      std::system_category().message(error));
+}
+
+} // namespace omicron
