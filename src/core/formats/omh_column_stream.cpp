@@ -19,6 +19,11 @@ constexpr std::uint64_t kWriteBytes = std::uint64_t{4} << 20;
 // publishes chunks of hundreds of thousands of points, so a millisecond late costs nothing.
 constexpr auto kPollInterval = std::chrono::milliseconds(1);
 constexpr std::uint64_t kAlign = AtomicFileWriter::kDirectAlignment;
+// Direct writes reach the device, not yet its persistent storage, and the extents they fill are
+// converted from unwritten in the journal: persisting 363 MB of columns at the commit took
+// 0.16-0.18 s after the build on the test VM. The thread persists them as it goes instead,
+// this many bytes at a time, while the build runs.
+constexpr std::uint64_t kPersistBytes = std::uint64_t{64} << 20;
 
 std::uint64_t columnsOffsetFor(int maxLevel) {
     omh::Header header;
@@ -125,7 +130,12 @@ void OmhColumnStream::run() {
                 }
             }
             if (complete) {
-                return; // every column written to its end
+                // Every column written to its end; the commit's fsync persists the last bytes
+                // with the rest of the file, without holding up the save before it.
+                return;
+            }
+            if (m_unpersisted >= kPersistBytes) {
+                persist();
             }
             if (!wrote) {
                 if (finishing) {
@@ -227,8 +237,16 @@ void OmhColumnStream::writeColumn(std::size_t c, std::uint64_t end) {
             written += static_cast<std::uint64_t>(n);
         }
         m_done[c] += count;
+        m_unpersisted += count;
         m_bytesWritten.fetch_add(count, std::memory_order_relaxed);
     }
+}
+
+void OmhColumnStream::persist() {
+    if (::fdatasync(m_direct) != 0) {
+        fail("cannot persist the deepest level's columns", errno);
+    }
+    m_unpersisted = 0;
 }
 
 void OmhColumnStream::fail(const std::string& what, int error) const {

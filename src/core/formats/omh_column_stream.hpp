@@ -64,6 +64,9 @@ private:
     // Writes column c's bytes [m_done[c], end) (end a multiple of the alignment, or the
     // column's end once the cloud is complete).
     void writeColumn(std::size_t c, std::uint64_t end);
+    // fdatasync: what was written so far reaches persistent storage, during the build rather
+    // than at the save's commit.
+    void persist();
     [[noreturn]] void fail(const std::string& what, int error) const;
 
     AtomicFileWriter& m_file;
@@ -77,6 +80,7 @@ private:
     std::vector<oms::PayloadChecksum> m_checksums;
     std::unique_ptr<std::uint8_t, void (*)(void*)> m_tail{nullptr, std::free}; // a last block
     int m_direct = -1;
+    std::uint64_t m_unpersisted = 0; // bytes written since the last persist()
     bool m_streaming = false;
     std::atomic<std::uint64_t> m_bytesWritten{0};
     std::atomic<bool> m_finishing{false}; // write up to the end, then stop
