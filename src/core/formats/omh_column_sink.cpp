@@ -38,6 +38,25 @@ bool holdsCloudInOrder(const Hierarchy& hierarchy, int level, std::uint64_t poin
 
 } // namespace
 
+const std::uint8_t* omhCloudColumn(const SortedCloud& cloud, const omh::Column& column) {
+    const auto bytes = [](auto span) {
+        return span.empty() ? nullptr : reinterpret_cast<const std::uint8_t*>(span.data());
+    };
+    switch (column.kind) {
+    case omh::ColumnKind::Position:
+        return bytes(cloud.positions());
+    case omh::ColumnKind::Normal:
+        return bytes(cloud.normals());
+    case omh::ColumnKind::Color:
+        return bytes(cloud.colors());
+    case omh::ColumnKind::Intensity: // in the records: not uniform, one value a point
+        return reinterpret_cast<const std::uint8_t*>(cloud.intensities().data);
+    case omh::ColumnKind::Las: // uniform but too long for the header: one record for all
+        return cloud.lasColumn().stride == column.bytes ? cloud.lasColumn().data : nullptr;
+    }
+    return nullptr;
+}
+
 std::uint8_t omhUniformColumns(const SortedCloud& cloud) {
     std::uint8_t bits = 0;
     if (cloud.uniformIntensities()) {
@@ -82,7 +101,7 @@ void OmhColumnSink::addNode(const OctreeNode& node, const NodeSplats& splats) {
     }
     const bool contiguous =
         node.holdsRange() && std::all_of(m_columns.begin(), m_columns.end(), [&](const auto& c) {
-            return columnData(static_cast<std::size_t>(&c - m_columns.data())) != nullptr;
+            return omhCloudColumn(m_cloud, c) != nullptr;
         });
     if (contiguous && node.coveredBegin == m_runEnd && m_runEnd - m_runBegin < kRunPoints) {
         m_runEnd += node.pointCount;
@@ -133,7 +152,8 @@ std::uint64_t OmhColumnSink::finishSection() {
 void OmhColumnSink::flushRun() {
     if (m_runEnd > m_runBegin) {
         for (std::size_t c = 0; c < m_columns.size(); ++c) {
-            writeColumn(c, columnData(c) + m_runBegin * m_columns[c].bytes, m_runEnd - m_runBegin);
+            writeColumn(c, omhCloudColumn(m_cloud, m_columns[c]) + m_runBegin * m_columns[c].bytes,
+                        m_runEnd - m_runBegin);
         }
     }
     m_runBegin = m_runEnd = 0;
@@ -150,26 +170,6 @@ void OmhColumnSink::writeColumn(std::size_t c, const std::uint8_t* bytes, std::s
         bytes += take;
         left -= take;
     }
-}
-
-const std::uint8_t* OmhColumnSink::columnData(std::size_t c) const {
-    const auto bytes = [](auto span) {
-        return reinterpret_cast<const std::uint8_t*>(span.data());
-    };
-    switch (m_columns[c].kind) {
-    case omh::ColumnKind::Position:
-        return m_cloud.positions().empty() ? nullptr : bytes(m_cloud.positions());
-    case omh::ColumnKind::Normal:
-        return bytes(m_cloud.normals());
-    case omh::ColumnKind::Color:
-        return m_cloud.colors().empty() ? nullptr : bytes(m_cloud.colors());
-    case omh::ColumnKind::Intensity: // in the records: not uniform, one value a point
-        return reinterpret_cast<const std::uint8_t*>(m_cloud.intensities().data);
-    case omh::ColumnKind::Las: // uniform but too long for the header: one record for all
-        return m_cloud.lasColumn().stride == m_columns[c].bytes ? m_cloud.lasColumn().data
-                                                                : nullptr;
-    }
-    return nullptr;
 }
 
 void OmhColumnSink::gather(std::size_t c, const OctreeNode& node, std::uint8_t* out) const {

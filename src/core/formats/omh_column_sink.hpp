@@ -26,6 +26,11 @@ namespace omicron {
 // The uniform columns (omh::kUniform* bits) a .omh of `cloud` declares in its header.
 std::uint8_t omhUniformColumns(const SortedCloud& cloud);
 
+// Column `column` of the cloud's points as the file stores it, contiguous, straight from the
+// cloud's array; null where the cloud does not keep it so (the packed store's positions and
+// colours, a uniform LAS column too long for the header).
+const std::uint8_t* omhCloudColumn(const SortedCloud& cloud, const omh::Column& column);
+
 // What omh_column_stream wrote: the columns of points [0, points) of `cloud` from byte
 // `offset` (omh::Header::columnsOffset), laid out as omh::columnStarts puts them, and each
 // column's XXH3-64. Empty (no cloud) when nothing was streamed.
@@ -61,9 +66,6 @@ private:
     void flushRun();
     // Hashes and writes `count` points' values of column `c`.
     void writeColumn(std::size_t c, const std::uint8_t* bytes, std::size_t count);
-    // Column `c` of the cloud's points, contiguous as the file stores it; null where the
-    // cloud does not keep it so (the packed store's positions and colours).
-    const std::uint8_t* columnData(std::size_t c) const;
     void gather(std::size_t c, const OctreeNode& node, std::uint8_t* out) const;
 
     AtomicFileWriter& m_file;

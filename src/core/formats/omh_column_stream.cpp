@@ -34,27 +34,6 @@ std::uint64_t columnsOffsetFor(int maxLevel) {
     return header.columnsOffset();
 }
 
-// The cloud's array that is `column` as the file stores it; null where there is none.
-const std::uint8_t* cloudColumn(const SortedCloud& cloud, const omh::Column& column) {
-    const omh::ColumnKind kind = column.kind;
-    const auto bytes = [](auto span) {
-        return span.empty() ? nullptr : reinterpret_cast<const std::uint8_t*>(span.data());
-    };
-    switch (kind) {
-    case omh::ColumnKind::Position:
-        return bytes(cloud.positions());
-    case omh::ColumnKind::Normal:
-        return bytes(cloud.normals());
-    case omh::ColumnKind::Color:
-        return bytes(cloud.colors());
-    case omh::ColumnKind::Intensity: // in the records: not uniform, one value a point
-        return reinterpret_cast<const std::uint8_t*>(cloud.intensities().data);
-    case omh::ColumnKind::Las: // uniform but too long for the header: one record for all
-        return cloud.lasColumn().stride == column.bytes ? cloud.lasColumn().data : nullptr;
-    }
-    return nullptr;
-}
-
 } // namespace
 
 OmhColumnStream::OmhColumnStream(AtomicFileWriter& file, int maxLevel,
@@ -160,7 +139,7 @@ bool OmhColumnStream::start(const SortedCloud& cloud) {
                               omhUniformColumns(cloud), omh::kFirstVersionWithDeepestColumns);
     m_written.columns = omh::recordColumns(layout);
     for (const omh::Column& column : m_written.columns) {
-        m_data.push_back(cloudColumn(cloud, column));
+        m_data.push_back(omhCloudColumn(cloud, column));
         if (m_data.back() == nullptr) {
             return false; // the packed store
         }

@@ -450,6 +450,18 @@ void OmhReader::checkPadding(std::uint64_t begin, std::uint64_t end) {
     }
 }
 
+void OmhReader::checkColumnarChecksum(const omh::LevelEntry& entry,
+                                      const std::vector<std::uint64_t>& digests) const {
+    const std::uint64_t digest = omh::columnarChecksum(digests);
+    if (digest != entry.payloadChecksum) {
+        throw InputError(InputErrorKind::MalformedValue, m_header.path,
+                         InputLocation::byte(entry.payloadOffset),
+                         "checksum mismatch in " + omhPayloadName(m_header, entry) +
+                             ": the level table stores XXH3-64 " + hexText(entry.payloadChecksum) +
+                             ", the bytes hash to " + hexText(digest));
+    }
+}
+
 void OmhReader::checkColumnPadding(const omh::LevelEntry& entry) {
     const std::vector<omh::Column> columns = m_header.columns();
     const std::vector<std::uint64_t> starts = omh::columnStarts(columns, entry.points);
@@ -634,14 +646,7 @@ void OmhReader::readColumnarPoints(int level, const std::vector<OctreeNode>& nod
         digests.push_back(column.digest());
     }
     digests.push_back(sparse.digest());
-    const std::uint64_t digest = omh::columnarChecksum(digests);
-    if (digest != entry.payloadChecksum) {
-        throw InputError(InputErrorKind::MalformedValue, m_header.path,
-                         InputLocation::byte(entry.payloadOffset),
-                         "checksum mismatch in " + omhPayloadName(m_header, entry) +
-                             ": the level table stores XXH3-64 " + hexText(entry.payloadChecksum) +
-                             ", they hash to " + hexText(digest));
-    }
+    checkColumnarChecksum(entry, digests);
     // Checked after the checksum, as the records are: in a damaged file the mismatch is the
     // better explanation.
     checkColumnPadding(entry);
@@ -841,14 +846,7 @@ void OmhReader::verify() {
         const std::uint64_t sparse = m_header.sparseSplatsOffset(e);
         digests.push_back(
             hashRange(sparse, e.sparsePoints * m_header.splatBytes(), omhPayloadName(m_header, e)));
-        const std::uint64_t digest = omh::columnarChecksum(digests);
-        if (digest != e.payloadChecksum) {
-            throw InputError(InputErrorKind::MalformedValue, m_header.path,
-                             InputLocation::byte(e.payloadOffset),
-                             "checksum mismatch in " + omhPayloadName(m_header, e) +
-                                 ": the level table stores XXH3-64 " + hexText(e.payloadChecksum) +
-                                 ", the bytes hash to " + hexText(digest));
-        }
+        checkColumnarChecksum(e, digests);
         checkColumnPadding(e);
     }
 }

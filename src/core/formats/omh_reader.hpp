@@ -78,6 +78,10 @@ private:
     // Version 4: the bytes [begin, end) (fewer than omh::kColumnAlignment) are zero, or an
     // InputError names the first that is not.
     void checkPadding(std::uint64_t begin, std::uint64_t end);
+    // A columnar level's checksum against the digests of its columns and sparse splat
+    // attributes, or an InputError naming the level's columns.
+    void checkColumnarChecksum(const omh::LevelEntry& entry,
+                               const std::vector<std::uint64_t>& digests) const;
     // ...and the padding after each column of the columnar level `entry`.
     void checkColumnPadding(const omh::LevelEntry& entry);
     // Version 4's deepest level: its columns straight into the cloud.
