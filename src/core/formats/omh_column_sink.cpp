@@ -76,15 +76,16 @@ OmhColumnSink::OmhColumnSink(AtomicFileWriter& file, const Hierarchy& hierarchy,
       m_estimatedNormal(header.estimatedNormals), m_columns(header.columns()),
       m_checksums(m_columns.size()) {
     const omh::LevelEntry& entry = header.levels[static_cast<std::size_t>(level)];
-    const std::vector<std::uint64_t> starts = omh::columnStarts(m_columns, entry.points);
+    m_spans = omh::columnSpans(m_columns, entry.points);
     for (std::size_t c = 0; c < m_columns.size(); ++c) {
-        m_at.push_back(entry.payloadOffset + starts[c]);
-        m_expectedEnd.push_back(m_at.back() + entry.points * m_columns[c].bytes);
-        m_paddingEnd.push_back(entry.payloadOffset + (c + 1 < m_columns.size()
-                                                          ? starts[c + 1]
-                                                          : header.recordsBytes(entry)));
-        m_writeBehind.emplace_back(m_at.back());
+        m_spans[c].begin += entry.payloadOffset;
+        m_spans[c].end += entry.payloadOffset;
+        m_spans[c].paddingEnd += entry.payloadOffset;
+        m_at.push_back(m_spans[c].begin);
+        m_writeBehind.emplace_back(m_spans[c].begin);
+        m_data.push_back(omhCloudColumn(m_cloud, m_columns[c]));
     }
+    m_contiguous = std::all_of(m_data.begin(), m_data.end(), [](auto data) { return data; });
     m_streamed = streamed != nullptr && streamed->cloud == &m_cloud &&
                  streamed->offset == entry.payloadOffset && streamed->points == entry.points &&
                  sameColumns(streamed->columns, m_columns) &&
@@ -99,10 +100,7 @@ void OmhColumnSink::addNode(const OctreeNode& node, const NodeSplats& splats) {
     if (m_streamed) {
         return;
     }
-    const bool contiguous =
-        node.holdsRange() && std::all_of(m_columns.begin(), m_columns.end(), [&](const auto& c) {
-            return omhCloudColumn(m_cloud, c) != nullptr;
-        });
+    const bool contiguous = m_contiguous && node.holdsRange();
     if (contiguous && node.coveredBegin == m_runEnd && m_runEnd - m_runBegin < kRunPoints) {
         m_runEnd += node.pointCount;
         return;
@@ -126,17 +124,17 @@ std::uint64_t OmhColumnSink::finishSection() {
     if (!m_streamed) {
         flushRun();
         for (std::size_t c = 0; c < m_columns.size(); ++c) {
-            if (m_at[c] != m_expectedEnd[c]) {
+            if (m_at[c] != m_spans[c].end) {
                 throw std::logic_error("the " + std::string(omh::columnName(m_columns[c].kind)) +
                                        " column ends at byte " + std::to_string(m_at[c]) +
-                                       ", expected " + std::to_string(m_expectedEnd[c]));
+                                       ", expected " + std::to_string(m_spans[c].end));
             }
             // Zeros up to the next column (the file may hold a stream's bytes there).
-            const std::vector<std::uint8_t> zeros(m_paddingEnd[c] - m_at[c], 0);
+            const std::vector<std::uint8_t> zeros(m_spans[c].paddingEnd - m_spans[c].end, 0);
             if (!zeros.empty()) {
-                m_file.writeAt(m_at[c], zeros.data(), zeros.size());
+                m_file.writeAt(m_spans[c].end, zeros.data(), zeros.size());
             }
-            m_writeBehind[c].finish(m_file, m_paddingEnd[c]);
+            m_writeBehind[c].finish(m_file, m_spans[c].paddingEnd);
             digests.push_back(m_checksums[c].digest());
         }
     }
@@ -152,8 +150,7 @@ std::uint64_t OmhColumnSink::finishSection() {
 void OmhColumnSink::flushRun() {
     if (m_runEnd > m_runBegin) {
         for (std::size_t c = 0; c < m_columns.size(); ++c) {
-            writeColumn(c, omhCloudColumn(m_cloud, m_columns[c]) + m_runBegin * m_columns[c].bytes,
-                        m_runEnd - m_runBegin);
+            writeColumn(c, m_data[c] + m_runBegin * m_columns[c].bytes, m_runEnd - m_runBegin);
         }
     }
     m_runBegin = m_runEnd = 0;

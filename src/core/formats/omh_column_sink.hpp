@@ -32,7 +32,7 @@ std::uint8_t omhUniformColumns(const SortedCloud& cloud);
 const std::uint8_t* omhCloudColumn(const SortedCloud& cloud, const omh::Column& column);
 
 // What omh_column_stream wrote: the columns of points [0, points) of `cloud` from byte
-// `offset` (omh::Header::columnsOffset), laid out as omh::columnStarts puts them, and each
+// `offset` (omh::Header::columnsOffset), laid out as omh::columnSpans puts them, and each
 // column's XXH3-64. Empty (no cloud) when nothing was streamed.
 struct OmhStreamedColumns {
     const SortedCloud* cloud = nullptr;
@@ -73,9 +73,10 @@ private:
     std::uint64_t m_sparseOffset;
     bool m_estimatedNormal;
     std::vector<omh::Column> m_columns;
-    std::vector<std::uint64_t> m_expectedEnd; // per column: where its last byte ends
-    std::vector<std::uint64_t> m_paddingEnd;  // ...and where the next column starts
-    std::vector<std::uint64_t> m_at;          // per column: where the next bytes go
+    std::vector<omh::ColumnSpan> m_spans;    // per column, absolute file offsets
+    std::vector<const std::uint8_t*> m_data; // per column: omhCloudColumn (null: gathered)
+    bool m_contiguous = false;               // every column is in m_data
+    std::vector<std::uint64_t> m_at;         // per column: where the next bytes go
     std::vector<oms::PayloadChecksum> m_checksums;
     std::vector<WriteBehind> m_writeBehind;
     std::vector<std::uint64_t> m_streamedDigests;

@@ -151,7 +151,8 @@ bool OmhColumnStream::start(const SortedCloud& cloud) {
     m_written.cloud = &cloud;
     m_written.offset = m_offset;
     m_written.points = cloud.capacity();
-    m_starts = omh::columnStarts(m_written.columns, m_written.points);
+    m_spans = omh::columnSpans(m_written.columns, m_written.points);
+    const std::uint64_t regionBytes = m_spans.back().end;
     m_done.assign(m_written.columns.size(), 0);
     m_checksums = std::vector<oms::PayloadChecksum>(m_written.columns.size());
     m_tail.reset(static_cast<std::uint8_t*>(std::aligned_alloc(kAlign, kAlign)));
@@ -162,15 +163,15 @@ bool OmhColumnStream::start(const SortedCloud& cloud) {
     // (It makes the file that long; writeOmh cuts it to what it finally holds.) On a tmpfs
     // only the room is checked: reserving there zeroes the pages serially, as AtomicFileWriter
     // knows.
-    const std::string noRoom = "no room for the " + std::to_string(m_offset + m_starts.back()) +
-                               " bytes of the deepest level";
+    const std::string noRoom =
+        "no room for the " + std::to_string(m_offset + regionBytes) + " bytes of the deepest level";
     struct statfs fs {};
     if (::fstatfs(m_direct, &fs) == 0 && fs.f_type == TMPFS_MAGIC) {
-        if (std::uint64_t{fs.f_bavail} * static_cast<std::uint64_t>(fs.f_bsize) < m_starts.back()) {
+        if (std::uint64_t{fs.f_bavail} * static_cast<std::uint64_t>(fs.f_bsize) < regionBytes) {
             fail(noRoom, ENOSPC);
         }
     } else if (::fallocate(m_direct, 0, static_cast<off_t>(m_offset),
-                           static_cast<off_t>(m_starts.back())) != 0 &&
+                           static_cast<off_t>(regionBytes)) != 0 &&
                (errno == ENOSPC || errno == EDQUOT)) {
         fail(noRoom, errno);
     }
@@ -180,54 +181,51 @@ bool OmhColumnStream::start(const SortedCloud& cloud) {
 
 void OmhColumnStream::writeColumn(std::size_t c, std::uint64_t end) {
     const std::uint8_t* data = m_data[c];
-    const std::uint64_t base = m_offset + m_starts[c];
+    const std::uint64_t base = m_offset + m_spans[c].begin;
     while (m_done[c] < end && !m_abandon.load()) {
-        const std::uint64_t whole = (end - m_done[c]) / kAlign * kAlign;
-        const std::uint64_t count = std::min(whole, kWriteBytes);
         const std::uint8_t* bytes = data + m_done[c];
-        if (count == 0) {
-            // The column's last, partial block, from an aligned copy padded with zeros (the
-            // padding before the next column, or bytes writeOmh writes after this).
-            const std::uint64_t rest = end - m_done[c];
-            std::memset(m_tail.get(), 0, kAlign);
-            std::memcpy(m_tail.get(), bytes, rest);
-            m_checksums[c].update(bytes, rest);
-            if (::pwrite(m_direct, m_tail.get(), kAlign, static_cast<off_t>(base + m_done[c])) !=
-                static_cast<ssize_t>(kAlign)) {
-                fail("cannot write the deepest level's " +
-                         std::string(omh::columnName(m_written.columns[c].kind)) + " column",
-                     errno);
-            }
-            m_done[c] = end;
-            m_bytesWritten.fetch_add(rest, std::memory_order_relaxed);
-            break;
-        }
+        const std::uint64_t whole = (end - m_done[c]) / kAlign * kAlign;
+        // The column's last, partial block goes from an aligned copy padded with zeros (the
+        // padding before the next column, or bytes writeOmh writes after this).
+        const std::uint64_t count = whole > 0 ? std::min(whole, kWriteBytes) : end - m_done[c];
         m_checksums[c].update(bytes, count);
-        std::uint64_t written = 0;
-        while (written < count) {
-            const ssize_t n = ::pwrite(m_direct, bytes + written, count - written,
-                                       static_cast<off_t>(base + m_done[c] + written));
-            if (n < 0 && errno == EINTR) {
-                continue;
-            }
-            if (n < 0 && errno == EINVAL) {
-                // Direct I/O refused after all (an alignment the device needs beyond the
-                // page's): nothing is streamed, writeOmh writes the columns.
-                m_streaming = false;
-                m_abandon.store(true);
-                return;
-            }
-            if (n <= 0) {
-                fail("cannot write the deepest level's " +
-                         std::string(omh::columnName(m_written.columns[c].kind)) + " column",
-                     n < 0 ? errno : EIO);
-            }
-            written += static_cast<std::uint64_t>(n);
+        if (whole == 0) {
+            std::memset(m_tail.get(), 0, kAlign);
+            std::memcpy(m_tail.get(), bytes, count);
+        }
+        if (!writeDirect(c, whole > 0 ? bytes : m_tail.get(), whole > 0 ? count : kAlign,
+                         base + m_done[c])) {
+            return;
         }
         m_done[c] += count;
         m_unpersisted += count;
         m_bytesWritten.fetch_add(count, std::memory_order_relaxed);
     }
+}
+
+bool OmhColumnStream::writeDirect(std::size_t c, const std::uint8_t* bytes, std::uint64_t count,
+                                  std::uint64_t at) {
+    for (std::uint64_t written = 0; written < count;) {
+        const ssize_t n =
+            ::pwrite(m_direct, bytes + written, count - written, static_cast<off_t>(at + written));
+        if (n < 0 && errno == EINTR) {
+            continue;
+        }
+        if (n < 0 && errno == EINVAL) {
+            // Direct I/O refused after all (an alignment the device needs beyond the page's):
+            // nothing is streamed, writeOmh writes the columns.
+            m_streaming = false;
+            m_abandon.store(true);
+            return false;
+        }
+        if (n <= 0) {
+            fail("cannot write the deepest level's " +
+                     std::string(omh::columnName(m_written.columns[c].kind)) + " column",
+                 n < 0 ? errno : EIO);
+        }
+        written += static_cast<std::uint64_t>(n);
+    }
+    return true;
 }
 
 void OmhColumnStream::persist() {

@@ -64,6 +64,10 @@ private:
     // Writes column c's bytes [m_done[c], end) (end a multiple of the alignment, or the
     // column's end once the cloud is complete).
     void writeColumn(std::size_t c, std::uint64_t end);
+    // pwrite of whole blocks at `at` through the direct descriptor; false where direct I/O
+    // turns out to be refused (the stream then stops, streaming nothing).
+    bool writeDirect(std::size_t c, const std::uint8_t* bytes, std::uint64_t count,
+                     std::uint64_t at);
     // fdatasync: what was written so far reaches persistent storage, during the build rather
     // than at the save's commit.
     void persist();
@@ -75,7 +79,7 @@ private:
     std::shared_ptr<const SortedCloud> m_cloud; // the thread's until finish()
     OmhStreamedColumns m_written;               // the thread's until finish()
     std::vector<const std::uint8_t*> m_data;    // each column's bytes in the cloud
-    std::vector<std::uint64_t> m_starts;        // omh::columnStarts for the capacity
+    std::vector<omh::ColumnSpan> m_spans;       // omh::columnSpans for the capacity
     std::vector<std::uint64_t> m_done;          // each column's bytes written
     std::vector<oms::PayloadChecksum> m_checksums;
     std::unique_ptr<std::uint8_t, void (*)(void*)> m_tail{nullptr, std::free}; // a last block

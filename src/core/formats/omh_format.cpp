@@ -56,15 +56,19 @@ const char* columnName(ColumnKind kind) {
     return "?";
 }
 
-std::vector<std::uint64_t> columnStarts(const std::vector<Column>& columns, std::uint64_t points) {
-    std::vector<std::uint64_t> starts;
-    std::uint64_t end = 0;
+std::vector<ColumnSpan> columnSpans(const std::vector<Column>& columns, std::uint64_t points) {
+    std::vector<ColumnSpan> spans;
+    std::uint64_t begin = 0;
     for (const Column& column : columns) {
-        starts.push_back(alignUp(end, kColumnAlignment));
-        end = starts.back() + points * column.bytes;
+        const std::uint64_t end = begin + points * column.bytes;
+        // The padding after the last column too: the sparse splat attributes (written after
+        // the build, through the page cache) start on a block of their own, so writing them
+        // never reads back a block the build wrote with direct I/O (a read that waited 0.17 s
+        // behind the write-back of the upper levels).
+        spans.push_back({begin, end, alignUp(end, kColumnAlignment)});
+        begin = spans.back().paddingEnd;
     }
-    starts.push_back(end);
-    return starts;
+    return spans;
 }
 
 std::uint64_t columnarChecksum(const std::vector<std::uint64_t>& digests) {
@@ -83,11 +87,7 @@ std::uint64_t Header::recordsBytes(const LevelEntry& level) const {
     if (!columnar(level)) {
         return level.points * recordBytes;
     }
-    // The padding after the last column too: the sparse splat attributes (written after the
-    // build, through the page cache) start on a block of their own, so writing them never
-    // reads back a block the build wrote with direct I/O (a read that waited 0.17 s behind the
-    // write-back of the upper levels).
-    return alignUp(columnStarts(columns(), level.points).back(), kColumnAlignment);
+    return columnSpans(columns(), level.points).back().paddingEnd; // a position column always
 }
 
 void assignOffsets(Header& header) {

@@ -202,9 +202,15 @@ const char* columnName(ColumnKind kind); // "position", "normal", ...
 constexpr std::uint64_t alignUp(std::uint64_t offset, std::uint64_t alignment) {
     return (offset + alignment - 1) / alignment * alignment;
 }
-// Where each column of `points` points starts, relative to the first (which is aligned), and
-// where the last one ends: columns.size() + 1 values.
-std::vector<std::uint64_t> columnStarts(const std::vector<Column>& columns, std::uint64_t points);
+// Where a column of a columnar level lies, relative to the level's first byte (aligned):
+// its values in [begin, end), then zeros up to paddingEnd, where the next column starts (after
+// the last column: the level's sparse splat attributes, from a boundary of their own).
+struct ColumnSpan {
+    std::uint64_t begin;
+    std::uint64_t end;
+    std::uint64_t paddingEnd;
+};
+std::vector<ColumnSpan> columnSpans(const std::vector<Column>& columns, std::uint64_t points);
 // The checksum of a columnar level's payload: XXH3-64 of the XXH3-64 digests of its columns
 // then of its sparse splat attributes, each as 8 little-endian bytes (the columns are hashed
 // separately, as they are written: side by side while the build publishes points).

@@ -87,19 +87,18 @@ std::string omhSectionAt(const omh::Header& header, std::uint64_t offset) {
         const std::uint64_t end = e.payloadOffset + header.recordsBytes(e);
         if (header.columnar(e) && offset >= e.payloadOffset && offset < end) {
             const std::vector<omh::Column> columns = header.columns();
-            const std::vector<std::uint64_t> starts = omh::columnStarts(columns, e.points);
-            std::size_t c = columns.size() - 1;
-            while (c > 0 && offset < e.payloadOffset + starts[c]) {
-                --c;
+            const std::vector<omh::ColumnSpan> spans = omh::columnSpans(columns, e.points);
+            std::size_t c = 0;
+            while (offset >= e.payloadOffset + spans[c].paddingEnd) {
+                ++c;
             }
-            const std::uint64_t begin = e.payloadOffset + starts[c];
-            const std::uint64_t columnEnd = begin + e.points * columns[c].bytes;
+            const std::uint64_t begin = e.payloadOffset + spans[c].begin;
+            const std::uint64_t columnEnd = e.payloadOffset + spans[c].end;
             const std::string column = std::string(omh::columnName(columns[c].kind)) +
                                        " column of " + levelName(static_cast<int>(l));
             if (offset >= columnEnd) {
-                const std::uint64_t next =
-                    c + 1 < columns.size() ? e.payloadOffset + starts[c + 1] : end;
-                return "the padding after the " + column + " (" + range(columnEnd, next) + ")";
+                return "the padding after the " + column + " (" +
+                       range(columnEnd, e.payloadOffset + spans[c].paddingEnd) + ")";
             }
             return "the " + column + " (" + range(begin, columnEnd) + ")";
         }
@@ -463,13 +462,8 @@ void OmhReader::checkColumnarChecksum(const omh::LevelEntry& entry,
 }
 
 void OmhReader::checkColumnPadding(const omh::LevelEntry& entry) {
-    const std::vector<omh::Column> columns = m_header.columns();
-    const std::vector<std::uint64_t> starts = omh::columnStarts(columns, entry.points);
-    for (std::size_t c = 0; c < columns.size(); ++c) {
-        const std::uint64_t end =
-            c + 1 < columns.size() ? starts[c + 1] : m_header.recordsBytes(entry);
-        checkPadding(entry.payloadOffset + starts[c] + entry.points * columns[c].bytes,
-                     entry.payloadOffset + end);
+    for (const omh::ColumnSpan& span : omh::columnSpans(m_header.columns(), entry.points)) {
+        checkPadding(entry.payloadOffset + span.end, entry.payloadOffset + span.paddingEnd);
     }
 }
 
@@ -836,12 +830,11 @@ void OmhReader::verify() {
             continue;
         }
         // Each column hashed on its own, then the sparse splat attributes (columnarChecksum).
-        const std::vector<omh::Column> columns = m_header.columns();
-        const std::vector<std::uint64_t> starts = omh::columnStarts(columns, e.points);
         std::vector<std::uint64_t> digests;
-        for (std::size_t c = 0; c < columns.size(); ++c) {
-            digests.push_back(hashRange(e.payloadOffset + starts[c], e.points * columns[c].bytes,
-                                        omhSectionAt(m_header, e.payloadOffset + starts[c])));
+        for (const omh::ColumnSpan& span : omh::columnSpans(m_header.columns(), e.points)) {
+            const std::uint64_t begin = e.payloadOffset + span.begin;
+            digests.push_back(
+                hashRange(begin, span.end - span.begin, omhSectionAt(m_header, begin)));
         }
         const std::uint64_t sparse = m_header.sparseSplatsOffset(e);
         digests.push_back(

@@ -18,6 +18,17 @@ OmhRecordDecoder::OmhRecordDecoder(const omh::Header& header, SortedCloud& cloud
       m_attributes(m_layout.attributes), m_estimatedNormals(header.estimatedNormals),
       m_cloud(cloud), m_splats(splats) {}
 
+namespace {
+
+// Whether `p` is finite and lies in the cell of the node `nodeCode`, whose level-21 codes are
+// shifted right by `shift` (both loaders' check of a stored position).
+bool inNodeCell(const glm::vec3& p, morton::Code nodeCode, int shift) {
+    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) &&
+           (morton::encodeUnit(p.x, p.y, p.z) >> shift) == nodeCode;
+}
+
+} // namespace
+
 std::size_t OmhRecordDecoder::store(const std::uint8_t* records, std::size_t count,
                                     std::size_t point, morton::Code nodeCode, int level) const {
     const int shift = 3 * (morton::kMaxLevel - level);
@@ -26,9 +37,7 @@ std::size_t OmhRecordDecoder::store(const std::uint8_t* records, std::size_t cou
     for (std::size_t r = 0; r < count; ++r, record += m_layout.bytes) {
         const std::size_t at = point + r;
         const auto p = loadRaw<glm::vec3>(record);
-        const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-        if ((!finite || (morton::encodeUnit(p.x, p.y, p.z) >> shift) != nodeCode) &&
-            firstBad == count) {
+        if (firstBad == count && !inNodeCell(p, nodeCode, shift)) {
             firstBad = r;
         }
         m_cloud.mutablePositions()[at] = p;
@@ -89,10 +98,10 @@ void OmhRecordDecoder::readColumns(FileStream& stream, int level, std::uint64_t 
                                    std::vector<oms::PayloadChecksum>* checksums) const {
     const omh::LevelEntry& entry = m_header.levels[static_cast<std::size_t>(level)];
     const std::vector<omh::Column> columns = omh::recordColumns(m_layout);
-    const std::vector<std::uint64_t> starts = omh::columnStarts(columns, entry.points);
+    const std::vector<omh::ColumnSpan> spans = omh::columnSpans(columns, entry.points);
     for (std::size_t c = 0; c < columns.size(); ++c) {
         const std::size_t bytes = columns[c].bytes;
-        const std::uint64_t offset = entry.payloadOffset + starts[c] + inLevel * bytes;
+        const std::uint64_t offset = entry.payloadOffset + spans[c].begin + inLevel * bytes;
         std::uint8_t* out = columnBase(m_cloud, columns[c].kind) + point * bytes;
         stream.seek(offset);
         const std::string section = omhSectionAt(m_header, offset);
@@ -113,9 +122,7 @@ std::size_t OmhRecordDecoder::firstMisplaced(std::size_t point, std::size_t coun
     const int shift = 3 * (morton::kMaxLevel - level);
     const glm::vec3* positions = m_cloud.positions().data() + point;
     for (std::size_t r = 0; r < count; ++r) {
-        const glm::vec3 p = positions[r];
-        const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-        if (!finite || (morton::encodeUnit(p.x, p.y, p.z) >> shift) != nodeCode) {
+        if (!inNodeCell(positions[r], nodeCode, shift)) {
             return r;
         }
     }
