@@ -12,7 +12,7 @@ if(NOT count EQUAL 1)
   message(FATAL_ERROR "expected one .tar.gz in ${OUT}, found ${count}")
 endif()
 execute_process(COMMAND tar tzf ${tarballs} OUTPUT_VARIABLE listing RESULT_VARIABLE result)
-foreach(expected bin/omicron-cli bin/omicron share/applications/omicron.desktop
+foreach(expected bin/omicron-cli bin/omicron-cli-render bin/omicron share/applications/omicron.desktop
         share/icons/hicolor/scalable/apps/omicron.svg)
   string(FIND "${listing}" "${expected}" at)
   if(at EQUAL -1)

@@ -236,7 +236,8 @@ const Command& buildCommand() {
         "build", "build the OMiCroN hierarchy of a cloud and print its statistics",
         "build IN [--depth 7] [--ratio 0.2] [--worklist N] [--collapse off|lossless|paper]\n"
         "                   [--threads T] [--chunks K] [--store exact|packed] [--save OUT.omh]\n"
-        "                   [--save-version 2|3] [--memory-budget SIZE] [--temp-dir DIR] [--json]",
+        "                   [--save-version 2|3|4] [--memory-budget SIZE] [--temp-dir DIR] "
+        "[--json]",
         "Builds the octree bottom-up with oblique hierarchy cuts while the input streams in:\n"
         "an unsorted cloud (PLY, LAS, LAZ, XYZ) goes through the incremental Morton sorter first\n"
         "(pipeline 1), a sorted stream (.oms) feeds the builder directly (pipeline 2).\n"

@@ -25,6 +25,10 @@ const Command& convertCommand();
 const Command& exportPotreeCommand();
 const Command& tileCommand();
 
+// `render`'s descriptions with `run`: omicron-cli's render command starts omicron-cli-render,
+// whose render command renders.
+Command renderCommandRunning(int (*run)(const std::vector<std::string>& args));
+
 // Prints "usage: omicron-cli USAGE" and the help text to stdout (for --help).
 void printCommandHelp(const Command& command);
 

@@ -2,12 +2,15 @@
 // uncoloured cloud; by default (auto) the bunny (no colours) is shaded and the lion (colours)
 // is not; both flags at once are a usage error. Its LAS colour modes: --color classification
 // draws the TerraScan tile in its classes' colours. Needs a display (the suite runs under Xvfb).
+// And render runs in omicron-cli-render, so that the other commands load no Qt GUI library.
 #include "points/asprs_classes.hpp"
 #include "run_process.hpp"
 #include "test_files.hpp"
 
 #include <QImage>
+#include <chrono>
 #include <cstdlib>
+#include <filesystem>
 #include <gtest/gtest.h>
 #include <string>
 #include <vector>
@@ -98,6 +101,39 @@ TEST(CliRender, ClassificationColoursTheClasses) {
     EXPECT_EQ(unknown.exitCode, 2);
     EXPECT_NE(unknown.err.find("classification, return-number or gps-time"), std::string::npos)
         << unknown.err;
+}
+
+// The libraries a command's process loads, as the dynamic loader reports them.
+std::string librariesLoadedBy(const std::string& program, const std::vector<std::string>& args,
+                              const TempDir& dir) {
+    const std::string log = dir.file("loader.txt");
+    test::RunningProcess child(program, args, {"LD_DEBUG=libs"}, log);
+    EXPECT_EQ(child.waitFor(std::chrono::seconds(30)), 0);
+    const std::vector<std::uint8_t> bytes = test::readBytes(log);
+    return {bytes.begin(), bytes.end()};
+}
+
+TEST(CliRender, OnlyTheRendererLoadsQtsGuiLibraries) {
+    TempDir dir;
+    const std::string cli = librariesLoadedBy(OMICRON_CLI_PATH, {"info", "--help"}, dir);
+    EXPECT_NE(cli.find("libtbb"), std::string::npos) << cli; // the loader's report is there
+    EXPECT_EQ(cli.find("libQt6Gui"), std::string::npos);
+    const std::string renderer =
+        (std::filesystem::path(OMICRON_CLI_PATH).parent_path() / "omicron-cli-render").string();
+    EXPECT_NE(librariesLoadedBy(renderer, {"render", "--help"}, dir).find("libQt6Gui"),
+              std::string::npos);
+}
+
+TEST(CliRender, WithoutTheRendererBesideItRenderSaysWhatIsMissing) {
+    TempDir dir;
+    const std::string lone = dir.file("omicron-cli");
+    std::filesystem::copy_file(OMICRON_CLI_PATH, lone);
+    const auto run = test::runProcess(lone, {"render", "in.ply", dir.file("out.png")});
+    EXPECT_EQ(run.exitCode, 1);
+    EXPECT_NE(run.err.find(dir.file("omicron-cli-render") + ": cannot start the renderer"),
+              std::string::npos)
+        << run.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("out.png")));
 }
 
 } // namespace
