@@ -14,8 +14,10 @@ RecordBlockReader::RecordBlockReader(FileStream& stream, std::uint64_t start,
       m_recordsPerBlock(std::max<std::size_t>(1, blockBytes / m_recordBytes)) {
     const std::size_t blockSize = static_cast<std::size_t>(
         std::min<std::uint64_t>(m_recordsPerBlock, m_recordCount) * m_recordBytes);
+    const PageSize pages = blockSize >= kHugePageBytes / 4 ? PageSize::Huge : PageSize::Small;
     for (Slot& slot : m_slots) {
-        slot.bytes.resize(blockSize + paddingBytes);
+        slot.bytes = HugePageArray<std::uint8_t>(blockSize + paddingBytes, pages);
+        std::fill_n(slot.bytes.data() + blockSize, paddingBytes, std::uint8_t{0});
     }
     m_stream.seek(m_start);
     if (m_recordCount == 0) {

@@ -5,10 +5,12 @@
 #include "io/overlapped_batch_consumer.hpp"
 #include "memory_budget.hpp"
 #include "points/huge_page_buffer.hpp"
+#include "points/huge_page_policy.hpp"
 #include "scene/scene_generator.hpp"
 
 #include <algorithm>
 #include <chrono>
+#include <future>
 #include <stdexcept>
 
 namespace omicron {
@@ -282,6 +284,10 @@ PipelineResult BuildPipeline::runCloud(const std::string& path, const PipelineOp
         hierarchyPositions.assign(positions.begin(), positions.end());
         hierarchyColors.assign(colors.begin(), colors.end());
     };
+    // The page-size probe (7 ms of first touches where the host takes freed pages back,
+    // points/huge_page_policy) runs on another core while the file is opened; the sorter's
+    // arrays wait for its answer.
+    const auto pageSizeProbe = std::async(std::launch::async, [] { return hugePagesPayOff(); });
     std::unique_ptr<PointReader> reader;
     try {
         reader = openPointCloud(path, openOptions);

@@ -496,11 +496,13 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
     }
     const std::vector<DonatedPages> pagesDone = pagesDoneAfterChunk(blockChunks, chunks);
 
-    // Written before they are read: not zero-filled (a pass over 18 MB for 24.2 M points).
-    const auto keys = std::make_unique_for_overwrite<std::uint64_t[]>(largestChunk);
-    const auto keyScratch = std::make_unique_for_overwrite<std::uint64_t[]>(largestChunk);
-    const auto indices = std::make_unique_for_overwrite<std::uint32_t[]>(largestChunk);
-    const auto indexScratch = std::make_unique_for_overwrite<std::uint32_t[]>(largestChunk);
+    // Written before they are read: not zero-filled (a pass over 18 MB for 24.2 M points),
+    // and on huge pages where they pay off: on small pages their 4,600 first touches took
+    // about 55 ms of the sort on the test VM.
+    HugePageArray<std::uint64_t> keys(largestChunk);
+    HugePageArray<std::uint64_t> keyScratch(largestChunk);
+    HugePageArray<std::uint32_t> indices(largestChunk);
+    HugePageArray<std::uint32_t> indexScratch(largestChunk);
     SortedCloud& cloud = *m_cloud;
 
     std::size_t nextChunk = 0;
@@ -531,7 +533,7 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                        for (std::size_t b = 0; b < from.blocks.size(); ++b) {
                            const std::size_t first = b * kBinBlock;
                            std::copy_n(from.blocks[b], std::min(kBinBlock, n - first),
-                                       indices.get() + at + first);
+                                       indices.data() + at + first);
                        }
                        // The bin's positions, gathered a block at a time and coded on
                        // vector lanes: with the byte table point by point inside the gather,
@@ -548,12 +550,12 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                                gathered[i] = m_input.positions[indices[first + i]];
                            }
                            morton::encodeUnitBatch(std::span(gathered.data(), count),
-                                                   std::span(keys.get() + first, count));
+                                                   std::span(keys.data() + first, count));
                        }
-                       radixSortByKey(std::span(keys.get() + at, n),
-                                      std::span(indices.get() + at, n),
-                                      std::span(keyScratch.get() + at, n),
-                                      std::span(indexScratch.get() + at, n));
+                       radixSortByKey(std::span(keys.data() + at, n),
+                                      std::span(indices.data() + at, n),
+                                      std::span(keyScratch.data() + at, n),
+                                      std::span(indexScratch.data() + at, n));
                    });
                    // Sorted bins are not read again: their blocks go back, a slab at a time
                    // as slabs empty, so what fills up meanwhile reuses the memory instead of
@@ -597,8 +599,8 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                                          }
                                          if (!m_input.las.empty()) {
                                              gatherColumn(out.las.data(), m_input.las.data(),
-                                                          indices.get(), range.begin(), range.end(),
-                                                          lasBytes);
+                                                          indices.data(), range.begin(),
+                                                          range.end(), lasBytes);
                                          }
                                      });
                    for (const std::size_t block : blocksDone[c]) {

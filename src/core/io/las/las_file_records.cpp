@@ -32,13 +32,19 @@ void LasFileRecords::forEachBlock(const BlockVisitor& visit) {
 }
 
 std::uint64_t LasFileRecords::sampleRecords(std::uint64_t maxRecords, const RecordVisitor& visit) {
+    // One pread per record, without a seek or a name unless it fails: a seek, a read and a
+    // string for each of 4,096 samples took 16 ms of every LAS opening on the test VM.
     const std::uint64_t samples = std::min(maxRecords, m_header.pointCount);
     std::vector<std::uint8_t> record(m_header.recordLength);
     for (std::uint64_t s = 0; s < samples; ++s) {
         const std::uint64_t index = s * m_header.pointCount / samples;
-        m_stream->seek(m_header.recordOffset(index));
-        m_stream->readExact(record.data(), record.size(),
-                            "point record " + std::to_string(index) + " (counting from 0)");
+        const std::uint64_t offset = m_header.recordOffset(index);
+        if (m_stream->readAt(offset, record.data(), record.size()) != record.size()) {
+            throw InputError(InputErrorKind::Truncated, m_stream->path(),
+                             InputLocation::byte(offset),
+                             "expected " + recordName(index) + " (" +
+                                 std::to_string(record.size()) + " bytes), but the file ends");
+        }
         visit(record.data());
     }
     return samples;
