@@ -6,6 +6,8 @@
 // touch positions only; bench/morton_bench measures coding over SoA vs packed records.
 #pragma once
 
+#include "points/batch_allocator.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <glm/gtc/type_precision.hpp>
@@ -80,11 +82,11 @@ constexpr std::size_t pointBytes(AttributeSet attributes) {
 
 struct PointBatch {
     AttributeSet attributes; // which optional vectors below are filled (one entry per point)
-    std::vector<glm::vec3> positions; // unit cube
-    std::vector<glm::vec3> normals;   // unit length where the source had them; may be (0,0,0)
-    std::vector<glm::u8vec3> colors;
-    std::vector<std::uint16_t> intensities;
-    std::vector<std::uint8_t> las; // attributes.lasBytes() bytes per point
+    BatchColumn<glm::vec3> positions; // unit cube
+    BatchColumn<glm::vec3> normals;   // unit length where the source had them; may be (0,0,0)
+    BatchColumn<glm::u8vec3> colors;
+    BatchColumn<std::uint16_t> intensities;
+    BatchColumn<std::uint8_t> las; // attributes.lasBytes() bytes per point
 
     std::size_t size() const { return positions.size(); }
     bool empty() const { return positions.empty(); }

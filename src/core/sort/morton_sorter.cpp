@@ -212,7 +212,7 @@ void IncrementalMortonSorter::checkUniformColumns(const PointBatch& batch, std::
         return;
     }
     if (m_uniform[kIntensities].load(std::memory_order_relaxed)) {
-        const std::vector<std::uint16_t>& values = batch.intensities;
+        const auto& values = batch.intensities;
         if (firstIndex == 0) {
             m_uniformIntensity = values[0];
         }
@@ -226,7 +226,7 @@ void IncrementalMortonSorter::checkUniformColumns(const PointBatch& batch, std::
     }
     if (m_uniform[kLas].load(std::memory_order_relaxed)) {
         const std::size_t bytes = m_input.attributes.lasBytes();
-        const std::vector<std::uint8_t>& records = batch.las;
+        const auto& records = batch.las;
         if (firstIndex == 0) {
             m_uniformLasRecord.assign(records.begin(), records.begin() + bytes);
         }

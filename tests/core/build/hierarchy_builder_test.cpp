@@ -426,7 +426,7 @@ void expectLeavesHoldTheFilesPoints(const test::BuildResult& result, const std::
             }
         }
     }
-    std::vector<glm::vec3> input = loaded.points.positions;
+    std::vector<glm::vec3> input(loaded.points.positions.begin(), loaded.points.positions.end());
     const auto less = [](const glm::vec3& a, const glm::vec3& b) {
         return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
     };

@@ -10,8 +10,8 @@
 namespace omicron {
 namespace {
 
-template <typename T> bool sameBytes(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+template <typename Column> bool sameBytes(const Column& a, const Column& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
 }
 
 bool identical(const GeneratedScene& a, const GeneratedScene& b) {

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <limits>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -94,7 +95,7 @@ ReadBack readAll(const std::string& path, const OpenOptions& openOptions = {},
     return result;
 }
 
-void expectInUnitCube(const std::vector<glm::vec3>& positions) {
+void expectInUnitCube(std::span<const glm::vec3> positions) {
     for (std::size_t i = 0; i < positions.size(); ++i) {
         const glm::vec3 p = positions[i];
         ASSERT_TRUE(p.x >= 0.0f && p.y >= 0.0f && p.z >= 0.0f && p.x <= 1.0f && p.y <= 1.0f &&

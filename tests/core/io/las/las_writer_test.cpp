@@ -163,7 +163,7 @@ TEST_P(LasWriterRoundTrip, ReadsBackEveryPointAndAttribute) {
         EXPECT_NE(back.info.formatDetail.find("16-bit colour scaled to 8 bits"), std::string::npos)
             << back.info.formatDetail;
     } else if (formatHasColor) {
-        EXPECT_EQ(back.points.colors, std::vector<glm::u8vec3>(1500, glm::u8vec3(0)));
+        EXPECT_EQ(back.points.colors, BatchColumn<glm::u8vec3>(1500, glm::u8vec3(0)));
     }
 }
 
@@ -192,7 +192,7 @@ TEST(LasWriterTest, ColourIsWrittenTimes257AndReadBackAsTheSame8BitValues) {
     const ReadBack back = readBack(path);
     EXPECT_EQ(back.points.colors, cloud.batch.colors);
     EXPECT_TRUE(back.info.attributes.has(Attribute::Intensity));
-    EXPECT_EQ(back.points.intensities, std::vector<std::uint16_t>(4, 0));
+    EXPECT_EQ(back.points.intensities, BatchColumn<std::uint16_t>(4, 0));
 }
 
 TEST(LasWriterTest, HeaderFieldsSitAtTheirSpecificationOffsets) {
@@ -309,8 +309,8 @@ TEST(LasWriterTest, AttributesTheBatchLacksAreWrittenAsZero) {
     writeLas(path, cloud.batch, cloud.cube, options(2, 3));
     const ReadBack back = readBack(path);
     expectSamePositions(cloud, back);
-    EXPECT_EQ(back.points.intensities, std::vector<std::uint16_t>(20, 0));
-    EXPECT_EQ(back.points.colors, std::vector<glm::u8vec3>(20, glm::u8vec3(0)));
+    EXPECT_EQ(back.points.intensities, BatchColumn<std::uint16_t>(20, 0));
+    EXPECT_EQ(back.points.colors, BatchColumn<glm::u8vec3>(20, glm::u8vec3(0)));
 }
 
 TEST(LasWriterTest, EmptyBatchWritesAHeaderThatTheReaderRejectsAsNoPoints) {

@@ -64,7 +64,7 @@ TEST(XyzLayout, ThreeColumnsArePositions) {
 TEST(XyzLayout, FourColumnsAddIntensity) {
     const TextCloud t("0 0 0 0\n1 1 1 65535\n2 2 2 1200.4\n");
     EXPECT_EQ(t.cloud.info.attributes, AttributeSet(Attribute::Intensity));
-    EXPECT_EQ(t.cloud.points.intensities, (std::vector<std::uint16_t>{0, 65535, 1200}));
+    EXPECT_EQ(t.cloud.points.intensities, (BatchColumn<std::uint16_t>{0, 65535, 1200}));
 }
 
 TEST(XyzLayout, SixIntegerColumnsAreColors) {
@@ -109,19 +109,19 @@ TEST(XyzLayout, SevenColumnsArePtsWithLeicaIntensity) {
     EXPECT_EQ(t.cloud.info.formatDetail,
               "XYZ text, 7 columns (x y z intensity r g b), space-separated, 1 header line, "
               "intensity -2048..2047 shifted to 0..4095");
-    EXPECT_EQ(t.cloud.points.intensities, (std::vector<std::uint16_t>{0, 4095}));
+    EXPECT_EQ(t.cloud.points.intensities, (BatchColumn<std::uint16_t>{0, 4095}));
     EXPECT_EQ(t.cloud.points.colors[1], glm::u8vec3(40, 50, 60));
     expectNear(t.source(1), {1, 2, 3});
 }
 
 TEST(XyzLayout, SevenColumnsWithPositiveIntensityKeepIt) {
     const TextCloud t("0 0 0 12 10 20 30\n1 2 3 40000 40 50 60\n", "scan.pts");
-    EXPECT_EQ(t.cloud.points.intensities, (std::vector<std::uint16_t>{12, 40000}));
+    EXPECT_EQ(t.cloud.points.intensities, (BatchColumn<std::uint16_t>{12, 40000}));
 }
 
 TEST(XyzLayout, FractionalUnitIntensitiesAreScaled) {
     const TextCloud t("0 0 0 0.5\n1 1 1 1\n2 2 2 0\n");
-    EXPECT_EQ(t.cloud.points.intensities, (std::vector<std::uint16_t>{32768, 65535, 0}));
+    EXPECT_EQ(t.cloud.points.intensities, (BatchColumn<std::uint16_t>{32768, 65535, 0}));
     EXPECT_NE(t.cloud.info.formatDetail.find("intensity 0..1 scaled to 0..65535"),
               std::string::npos);
 }
@@ -196,7 +196,7 @@ TEST(XyzNonFinite, NanAndInfinityPointsAreSkippedAndCounted) {
 TEST(XyzNonFinite, AttributesOfSkippedPointsAreNotChecked) {
     const TextCloud t("nan nan nan nan 999 0 0\n1 2 3 7 1 2 3\n", "scan.pts");
     EXPECT_EQ(t.cloud.summary.skippedNonFinite, 1u);
-    EXPECT_EQ(t.cloud.points.intensities, (std::vector<std::uint16_t>{7}));
+    EXPECT_EQ(t.cloud.points.intensities, (BatchColumn<std::uint16_t>{7}));
 }
 
 TEST(XyzStreaming, BatchesAreBoundedAndCancelStops) {

@@ -1,0 +1,62 @@
+// The allocator of a PointBatch's columns. A reader fills one batch of 65,536 points and hands
+// it to the sorter, which keeps two more: their big columns (positions, the LAS column) are
+// fresh memory, touched once each, and on this project's test VM a first touch costs 3 ms per
+// MiB on small pages against 0.08 ms on huge pages (2,200 page faults, about 25 ms, mostly on
+// the reader's thread before the sorter had anything to do). A column of 256 KiB or more is
+// therefore a whole number of 2 MiB pages advised as huge where they pay off
+// (points/huge_page_policy.hpp); smaller ones come from the heap as before.
+#pragma once
+
+#include "points/huge_page_policy.hpp"
+
+#include <cstddef>
+#include <cstdlib>
+#include <limits>
+#include <memory>
+#include <new>
+#include <sys/mman.h>
+#include <vector>
+
+namespace omicron {
+
+template <typename T> struct BatchAllocator {
+    using value_type = T;
+    static constexpr std::size_t kHugeFromBytes = std::size_t{256} << 10;
+    static constexpr std::size_t kPageBytes = std::size_t{2} << 20;
+    static constexpr std::size_t kMaxBytes = std::numeric_limits<std::ptrdiff_t>::max() / 2;
+
+    BatchAllocator() noexcept = default;
+    template <typename U> BatchAllocator(const BatchAllocator<U>&) noexcept {}
+
+    T* allocate(std::size_t count) {
+        if (count > kMaxBytes / sizeof(T)) {
+            throw std::bad_array_new_length();
+        }
+        const std::size_t bytes = count * sizeof(T);
+        if (bytes < kHugeFromBytes) {
+            return std::allocator<T>{}.allocate(count);
+        }
+        const std::size_t mapped = (bytes + kPageBytes - 1) / kPageBytes * kPageBytes;
+        void* memory = std::aligned_alloc(kPageBytes, mapped);
+        if (memory == nullptr) {
+            throw std::bad_alloc();
+        }
+        madvise(memory, mapped, hugePagesPayOff() ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
+        return static_cast<T*>(memory);
+    }
+
+    void deallocate(T* memory, std::size_t count) noexcept {
+        if (count * sizeof(T) < kHugeFromBytes) {
+            std::allocator<T>{}.deallocate(memory, count);
+        } else {
+            std::free(memory);
+        }
+    }
+
+    friend bool operator==(const BatchAllocator&, const BatchAllocator&) noexcept { return true; }
+};
+
+// A column of a PointBatch.
+template <typename T> using BatchColumn = std::vector<T, BatchAllocator<T>>;
+
+} // namespace omicron
