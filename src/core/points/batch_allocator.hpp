@@ -4,17 +4,15 @@
 // MiB on small pages against 0.08 ms on huge pages (2,200 page faults, about 25 ms, mostly on
 // the reader's thread before the sorter had anything to do). A column of 256 KiB or more is
 // therefore a whole number of 2 MiB pages advised as huge where they pay off
-// (points/huge_page_policy.hpp); smaller ones come from the heap as before.
+// (points/huge_page_buffer.hpp); smaller ones come from the heap as before.
 #pragma once
 
-#include "points/huge_page_policy.hpp"
+#include "points/huge_page_buffer.hpp"
 
 #include <cstddef>
-#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <new>
-#include <sys/mman.h>
 #include <vector>
 
 namespace omicron {
@@ -22,7 +20,6 @@ namespace omicron {
 template <typename T> struct BatchAllocator {
     using value_type = T;
     static constexpr std::size_t kHugeFromBytes = std::size_t{256} << 10;
-    static constexpr std::size_t kPageBytes = std::size_t{2} << 20;
     static constexpr std::size_t kMaxBytes = std::numeric_limits<std::ptrdiff_t>::max() / 2;
 
     BatchAllocator() noexcept = default;
@@ -32,17 +29,10 @@ template <typename T> struct BatchAllocator {
         if (count > kMaxBytes / sizeof(T)) {
             throw std::bad_array_new_length();
         }
-        const std::size_t bytes = count * sizeof(T);
-        if (bytes < kHugeFromBytes) {
+        if (count * sizeof(T) < kHugeFromBytes) {
             return std::allocator<T>{}.allocate(count);
         }
-        const std::size_t mapped = (bytes + kPageBytes - 1) / kPageBytes * kPageBytes;
-        void* memory = std::aligned_alloc(kPageBytes, mapped);
-        if (memory == nullptr) {
-            throw std::bad_alloc();
-        }
-        madvise(memory, mapped, hugePagesPayOff() ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
-        return static_cast<T*>(memory);
+        return static_cast<T*>(allocateInHugePages(count * sizeof(T), PageSize::Huge));
     }
 
     void deallocate(T* memory, std::size_t count) noexcept {

@@ -135,6 +135,20 @@ inline void touchWholePages(void* memory, std::size_t bytes) {
     }
 }
 
+// `bytes` rounded up to whole 2 MiB pages, aligned to one and advised as huge where `pages`
+// asks for them and they pay off (small pages otherwise); uninitialised, freed with std::free.
+// Advice only: a refusal leaves the kernel's default. Throws std::bad_alloc.
+inline void* allocateInHugePages(std::size_t bytes, PageSize pages) {
+    const std::size_t mapped = hugePageArrayBytes(bytes);
+    void* memory = std::aligned_alloc(kHugePageBytes, mapped);
+    if (memory == nullptr) {
+        throw std::bad_alloc();
+    }
+    const bool huge = pages == PageSize::Huge && hugePagesPayOff();
+    madvise(memory, mapped, huge ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
+    return memory;
+}
+
 template <typename T> class HugePageArray {
     static_assert(std::is_trivially_copyable_v<T>, "elements are left uninitialised");
 
@@ -155,15 +169,7 @@ public:
         if (size == 0) {
             return;
         }
-        const std::size_t bytes = hugePageArrayBytes(size * sizeof(T));
-        void* memory = std::aligned_alloc(kHugePageBytes, bytes);
-        if (memory == nullptr) {
-            throw std::bad_alloc();
-        }
-        // Advice only: a refusal leaves the kernel's default.
-        const bool huge = pages == PageSize::Huge && hugePagesPayOff();
-        madvise(memory, bytes, huge ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
-        m_data.reset(static_cast<T*>(memory));
+        m_data.reset(static_cast<T*>(allocateInHugePages(size * sizeof(T), pages)));
     }
 
     std::size_t size() const { return m_size; }
