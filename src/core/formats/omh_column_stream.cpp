@@ -5,9 +5,7 @@
 #include <chrono>
 #include <cstring>
 #include <fcntl.h>
-#include <linux/magic.h>
 #include <new>
-#include <sys/vfs.h>
 #include <system_error>
 #include <unistd.h>
 
@@ -160,21 +158,8 @@ bool OmhColumnStream::start(const SortedCloud& cloud) {
         throw std::bad_alloc();
     }
     // The whole region's room at once: a full disk fails here, before the build has gone far.
-    // (It makes the file that long; writeOmh cuts it to what it finally holds.) On a tmpfs
-    // only the room is checked: reserving there zeroes the pages serially, as AtomicFileWriter
-    // knows.
-    const std::string noRoom =
-        "no room for the " + std::to_string(m_offset + regionBytes) + " bytes of the deepest level";
-    struct statfs fs {};
-    if (::fstatfs(m_direct, &fs) == 0 && fs.f_type == TMPFS_MAGIC) {
-        if (std::uint64_t{fs.f_bavail} * static_cast<std::uint64_t>(fs.f_bsize) < regionBytes) {
-            fail(noRoom, ENOSPC);
-        }
-    } else if (::fallocate(m_direct, 0, static_cast<off_t>(m_offset),
-                           static_cast<off_t>(regionBytes)) != 0 &&
-               (errno == ENOSPC || errno == EDQUOT)) {
-        fail(noRoom, errno);
-    }
+    // (It makes the file that long; writeOmh cuts it to what it finally holds.)
+    m_file.reserve(m_offset, regionBytes, "the deepest level");
     m_streaming = true;
     return true;
 }

@@ -89,7 +89,7 @@ AtomicFileWriter::~AtomicFileWriter() {
     }
 }
 
-void AtomicFileWriter::fail(const std::string& what, int error) {
+void AtomicFileWriter::fail(const std::string& what, int error) const {
     throw OutputError(m_targetPath + ": " + what + ": " + std::strerror(error));
 }
 
@@ -159,20 +159,10 @@ void AtomicFileWriter::extendTo(std::uint64_t size) {
     const auto from = static_cast<off_t>(m_onFile);
     const auto count = static_cast<off_t>(size - m_onFile);
     if (count > 0) {
-        const std::string noRoom = "no room for the " + std::to_string(size) + " bytes of the file";
-        // fallocate rather than posix_fallocate: where the file system cannot reserve, the
-        // region is left sparse (ftruncate) instead of being written with zeros first. A tmpfs
-        // only has its room checked, and the region is left sparse on purpose.
-        bool reserved = false;
-        if (const std::optional<std::uint64_t> tmpfsFree = tmpfsFreeBytes(m_fd)) {
-            if (*tmpfsFree < static_cast<std::uint64_t>(count)) {
-                fail(noRoom, ENOSPC);
-            }
-        } else if (::fallocate(m_fd, 0, from, count) == 0) {
-            reserved = true;
-        } else if (errno == ENOSPC || errno == EDQUOT) {
-            fail(noRoom, errno);
-        }
+        // Where the file system cannot reserve, the region is left sparse (ftruncate) instead
+        // of being written with zeros first; on a tmpfs on purpose.
+        const bool reserved = reserve(static_cast<std::uint64_t>(from),
+                                      static_cast<std::uint64_t>(count), "the file");
         if (!reserved && ::ftruncate(m_fd, static_cast<off_t>(size)) != 0) {
             fail("cannot extend the file to " + std::to_string(size) + " bytes", errno);
         }
@@ -182,6 +172,27 @@ void AtomicFileWriter::extendTo(std::uint64_t size) {
     }
     m_onFile = m_bytesWritten = size;
     m_writeBehind = WriteBehind(size); // the regions before it are released by their writers
+}
+
+bool AtomicFileWriter::reserve(std::uint64_t offset, std::uint64_t count,
+                               const std::string& what) const {
+    const std::string noRoom =
+        "no room for the " + std::to_string(offset + count) + " bytes of " + what;
+    if (const std::optional<std::uint64_t> tmpfsFree = tmpfsFreeBytes(m_fd)) {
+        if (*tmpfsFree < count) {
+            fail(noRoom, ENOSPC);
+        }
+        return false;
+    }
+    // fallocate rather than posix_fallocate: where the file system cannot reserve, nothing is
+    // written with zeros instead.
+    if (::fallocate(m_fd, 0, static_cast<off_t>(offset), static_cast<off_t>(count)) == 0) {
+        return true;
+    }
+    if (errno == ENOSPC || errno == EDQUOT) {
+        fail(noRoom, errno);
+    }
+    return false;
 }
 
 void AtomicFileWriter::truncateTo(std::uint64_t size) {

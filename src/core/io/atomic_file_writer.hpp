@@ -54,6 +54,13 @@ public:
     // memory serially, before the writers could).
     void extendTo(std::uint64_t size);
 
+    // Reserves bytes [offset, offset + count) of the file on disk (the file becomes at least
+    // that long); returns false where the file system cannot reserve, leaving it as it was.
+    // No room is an OutputError naming offset + count bytes of `what` ("the file"). On a tmpfs
+    // only the free space is checked (false): reserving there would zero the memory serially.
+    // Any thread, on a file no other thread resizes meanwhile.
+    bool reserve(std::uint64_t offset, std::uint64_t count, const std::string& what) const;
+
     // Cuts the file to `size` bytes (size <= bytesWritten()): for a file another descriptor
     // (openDirect) made longer than what it finally holds. write() continues at `size`.
     void truncateTo(std::uint64_t size);
@@ -61,7 +68,7 @@ public:
     // A second descriptor of the temporary file for direct I/O (O_DIRECT: writes bypass the
     // page cache; offsets, lengths and buffers aligned to kDirectAlignment), for a region
     // that a thread of its own fills; the caller closes it. -1 where the file system refuses
-    // direct I/O (a tmpfs).
+    // direct I/O (a tmpfs before Linux 6.6).
     int openDirect() const;
     static constexpr std::size_t kDirectAlignment = 4096;
 
@@ -81,7 +88,7 @@ public:
 
 private:
     void flushBuffer();
-    [[noreturn]] void fail(const std::string& what, int error);
+    [[noreturn]] void fail(const std::string& what, int error) const;
     // Gives the nameless temporary its hidden name beside the target, for the rename.
     void nameTemporary();
 
