@@ -128,19 +128,14 @@ struct BuildResult {
     std::unique_ptr<HierarchyBuilder> builder;
 };
 
-// Through the real incremental sorter, ranges of `rangePoints`, or (kWholeChunkRanges) each
-// sorted chunk as one range, as the build pipeline asks for.
-inline constexpr std::size_t kWholeChunkRanges = 0;
+// Through the real incremental sorter, ranges of `rangePoints` (as in production).
 inline BuildResult buildSynthetic(const SyntheticCloud& cloud, const BuildOptions& options,
                                   std::size_t rangePoints = 4096, int sortChunks = 8,
                                   PointStorage storage = PointStorage::Exact) {
     SortOptions sortOptions;
     sortOptions.chunks = sortChunks;
     sortOptions.storage = storage;
-    sortOptions.wholeChunkRanges = rangePoints == kWholeChunkRanges;
-    if (!sortOptions.wholeChunkRanges) {
-        sortOptions.batchPoints = rangePoints;
-    }
+    sortOptions.batchPoints = rangePoints;
     IncrementalMortonSorter sorter(cloud.info, sortOptions);
     sorter.add(cloud.points);
     BuildResult result;

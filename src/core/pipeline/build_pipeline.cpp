@@ -38,7 +38,6 @@ SortOptions sortOptionsOf(const PipelineOptions& options, const std::atomic<bool
     sortOptions.storage = options.storage;
     sortOptions.memoryBudgetBytes = options.memoryBudgetBytes;
     sortOptions.tempDir = options.tempDir;
-    sortOptions.wholeChunkRanges = true; // the builder takes each sorted chunk in one pass
     if (!options.preview) {
         sortOptions.previewPoints = 0;
     }

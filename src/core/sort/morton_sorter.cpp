@@ -612,14 +612,12 @@ int IncrementalMortonSorter::sortAndEmit(const SortedRangeConsumer& consumer) {
                }) &
                tbb::make_filter<std::size_t, void>(
                    tbb::filter_mode::serial_in_order, [&](std::size_t c) {
-                       const std::size_t rangePoints = m_options.wholeChunkRanges
-                                                           ? chunkBegin[c + 1] - chunkBegin[c]
-                                                           : m_options.batchPoints;
                        for (std::size_t begin = chunkBegin[c]; begin < chunkBegin[c + 1];) {
                            if (cancelled()) {
                                return;
                            }
-                           const std::size_t end = std::min(chunkBegin[c + 1], begin + rangePoints);
+                           const std::size_t end =
+                               std::min(chunkBegin[c + 1], begin + m_options.batchPoints);
                            if (m_firstRangeSeconds < 0.0) {
                                m_firstRangeSeconds = secondsSince(start);
                            }

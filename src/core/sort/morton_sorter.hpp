@@ -42,15 +42,6 @@ inline constexpr int kMaxSortChunks = 256;
 struct SortOptions {
     int chunks = kDefaultSortChunks;                  // 1..256
     std::size_t batchPoints = std::size_t{1} << 16;   // largest range handed to the consumer
-    // An in-memory sort hands each sorted chunk to sortAndEmit()'s consumer as one range
-    // instead of ranges of batchPoints. The chunk is published whole before its first range
-    // is handed over, so its ranges came microseconds apart, and the builder made a fix pass
-    // (a oneTBB fork-join per level) for the first and another for the rest: 127 passes for
-    // 24.2 M points against 34, the same hierarchy (two cores: 0.94 -> 0.90 s and 0.855 ->
-    // 0.805 s, medians of 12 alternating builds; one core unchanged). What builds a
-    // hierarchy asks for it; a consumer that writes each range (omicron-cli sort) keeps
-    // batchPoints for its progress and its cancel checks.
-    bool wholeChunkRanges = false;
     std::size_t previewPoints = std::size_t{1} << 16; // size of the random preview sample
     std::uint64_t previewSeed = 0x9e3779b97f4a7c15ull;
     const std::atomic<bool>* cancel = nullptr;        // checked between chunks and batches

@@ -204,9 +204,7 @@ TEST(HierarchyBuilder, ResultIsIdenticalForEveryThreadCountWorklistAndRangeSize)
                              std::to_string(worklist));
                 options.threads = threads;
                 options.worklistSize = worklist;
-                const std::size_t rangePoints = worklist == 3    ? 97
-                                                : worklist == 16 ? test::kWholeChunkRanges
-                                                                 : 4096;
+                const std::size_t rangePoints = worklist == 3 ? 97 : 4096;
                 const auto result = buildSynthetic(cloud, options, rangePoints, 16);
                 EXPECT_EQ(result.builder->statistics().invariantViolation, "");
                 EXPECT_EQ(fingerprint(result.builder->hierarchy()), expected);

@@ -320,44 +320,6 @@ TEST(MortonSorter, ChunkedModeEmitsBeforeTheLastChunkIsSorted) {
     EXPECT_LE(publishedAtFirstRange, 2 * cloud.points.size() / 16 + 4096);
 }
 
-TEST(MortonSorter, WholeChunkRangesHandEachSortedChunkAsOneRange) {
-    const SyntheticCloud cloud = makeCloud(Shape::Random, 150000, 6);
-    const auto sortWith = [&](bool wholeChunks) {
-        SortOptions options;
-        options.chunks = 8;
-        options.batchPoints = 1000;
-        options.wholeChunkRanges = wholeChunks;
-        IncrementalMortonSorter sorter(cloud.info, options);
-        sorter.add(cloud.points);
-        std::vector<std::pair<std::size_t, std::size_t>> ranges;
-        std::vector<std::size_t> publishedAtRange;
-        const int chunks =
-            sorter.sortAndEmit([&](const SortedCloud& sorted, std::size_t begin, std::size_t end) {
-                EXPECT_EQ(begin, ranges.empty() ? 0 : ranges.back().second);
-                EXPECT_LE(end, sorted.sortedEnd());
-                ranges.emplace_back(begin, end);
-                publishedAtRange.push_back(sorted.sortedEnd());
-            });
-        std::vector<morton::Code> codes;
-        for (std::size_t i = 0; i < sorter.cloud()->sortedEnd(); ++i) {
-            codes.push_back(sorter.cloud()->code(i));
-        }
-        return std::tuple(chunks, ranges, codes);
-    };
-    const auto [wholeChunks, wholeRanges, wholeCodes] = sortWith(true);
-    const auto [batchChunks, batchRanges, batchCodes] = sortWith(false);
-    ASSERT_EQ(wholeChunks, 8);
-    EXPECT_EQ(batchChunks, 8);
-    // One range per chunk, where ranges of batchPoints cut each chunk into many.
-    ASSERT_EQ(wholeRanges.size(), 8u);
-    EXPECT_GT(batchRanges.size(), 100u);
-    EXPECT_EQ(wholeRanges.back().second, cloud.points.size());
-    for (const auto& [begin, end] : wholeRanges) {
-        EXPECT_GT(end - begin, 1000u);
-    }
-    EXPECT_EQ(wholeCodes, batchCodes);
-}
-
 TEST(MortonSorter, CancellationStopsBetweenRangesAndLeavesCloudIncomplete) {
     const SyntheticCloud cloud = makeCloud(Shape::Random, 100000, 5);
     std::atomic<bool> cancel{false};
