@@ -14,8 +14,8 @@
 //
 // Nothing is streamed (finish() hands back an empty result) for a cloud in a scratch file
 // (reading it here would fault its pages in behind the budget's back), in the packed store (no
-// array is a column), or on a file system without direct I/O (a tmpfs before Linux 6.6:
-// there the copy into the page cache would take the sort's cores); writeOmh then writes the columns
+// array is a column), or on a file system without direct I/O (a tmpfs before Linux 6.6: there
+// the copy into the page cache would take the sort's cores); writeOmh then writes the columns
 // after the build, still without encoding them.
 #pragma once
 

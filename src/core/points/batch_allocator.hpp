@@ -10,6 +10,7 @@
 #include "points/huge_page_buffer.hpp"
 
 #include <cstddef>
+#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <new>
@@ -29,21 +30,25 @@ template <typename T> struct BatchAllocator {
         if (count > kMaxBytes / sizeof(T)) {
             throw std::bad_array_new_length();
         }
-        if (count * sizeof(T) < kHugeFromBytes) {
+        if (!onHugePages(count)) {
             return std::allocator<T>{}.allocate(count);
         }
         return static_cast<T*>(allocateInHugePages(count * sizeof(T), PageSize::Huge));
     }
 
     void deallocate(T* memory, std::size_t count) noexcept {
-        if (count * sizeof(T) < kHugeFromBytes) {
-            std::allocator<T>{}.deallocate(memory, count);
-        } else {
+        if (onHugePages(count)) {
             std::free(memory);
+        } else {
+            std::allocator<T>{}.deallocate(memory, count);
         }
     }
 
     friend bool operator==(const BatchAllocator&, const BatchAllocator&) noexcept { return true; }
+
+private:
+    // Where a column of `count` values lives: allocate and deallocate must agree.
+    static bool onHugePages(std::size_t count) { return count * sizeof(T) >= kHugeFromBytes; }
 };
 
 // A column of a PointBatch.
