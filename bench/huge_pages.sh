@@ -36,6 +36,6 @@ huge=$(echo "${walls[huge]}" | median)
 small=$(echo "${walls[small]}" | median)
 reported=$(cat /sys/module/page_reporting/parameters/reported_kib 2>/dev/null || echo 0)
 # What the policy picks with no override (where reporting is active it measures, per process).
-policy=$("$cli" build "$input" --json | grep -o '"pages":"[a-z]*"' | cut -d'"' -f4)
+policy=$("$cli" build "$input" --json | json_field pages -)
 awk -v p="$points" -v h="$huge" -v s="$small" -v r="$reported" -v pol="$policy" 'BEGIN {
   printf "bench=huge_pages summary points=%d huge_wall_s=%.2f small_wall_s=%.2f small_speedup=%.2f reported_kib=%s policy=%s\n", p, h, s, h / s, r, pol }'

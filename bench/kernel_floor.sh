@@ -39,14 +39,9 @@ echo "bench=kernel_floor step=input cloud=$(basename "$cloud") copies=$copies po
 ours_users=""
 declare -A syss
 for run in $(seq 1 "$runs"); do
-  # The dd runs first, then ours and the memory step back to back, which of them first
-  # alternating: on a VM that hands freed memory back to its host, the first big process after
-  # a second of little memory use faults its memory in at several times the cost (README, "the
-  # host's slow phase"); the memory step used to come after the dd runs and alone paid that,
-  # which raised the floor.
-  pair="ours memory"
-  [ $((run % 2)) -eq 0 ] && pair="memory ours"
-  for step in read write omh_read $pair; do
+  # The memory step used to come right after the dd runs and alone paid the host's slow
+  # phase, which raised the floor.
+  for step in read write omh_read $(in_turn "$run" ours memory); do
     case $step in
       ours) read -r wall user sys rss < <(measure_build kernel_floor) ;;
       read) read -r wall user sys rss < <(measure dd if="$input" of=/dev/null bs=1M status=none) ;;

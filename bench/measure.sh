@@ -16,6 +16,23 @@ median() {
     awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
 }
 
+# The value of field NAME in the JSON of FILE (`-`: standard input), a number or a string
+# (without its quotes); nothing when absent. Enough for `omicron-cli ... --json`'s flat fields.
+# usage: json_field NAME FILE
+json_field() {
+  grep -o "\"$1\":\(\"[^\"]*\"\|[0-9.eE+-]*\)" "$2" | head -n 1 | cut -d: -f2- | tr -d '"' || true
+}
+
+# Two memory-heavy steps of run RUN in the order to run them: A B in odd runs, B A in even ones.
+# They run back to back after a script's light steps (dd and the like): on a VM that hands freed
+# memory back to its host, the first big process after a second of little memory use faults its
+# memory in at several times the cost (README, "the host's slow phase"), and a step that always
+# came first after the light ones paid that alone.
+# usage: in_turn RUN A B
+in_turn() {
+  if [ $(($1 % 2)) -eq 0 ]; then echo "$3 $2"; else echo "$2 $3"; fi
+}
+
 # The number of points `omicron-cli info` reports for a cloud file ($cli: the omicron-cli binary).
 points_in() {
   "$cli" info "$1" | awk '/^points:/ { print $2 }'

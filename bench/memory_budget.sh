@@ -37,6 +37,6 @@ for budget in none "${budgets[@]}"; do
   echo "bench=memory_budget command=sort budget=$budget points=$points wall_s=$wall user_s=$user sys_s=$sys peak_rss_mib=$((rss / 1024)) sort_runs=${runs:-0} oms_md5=$digest"
   rm -f "$work/sorted.oms"
   read -r wall user sys rss < <(measure "$cli" build "$input" --json "${flags[@]}")
-  runs=$(grep -o '"sort_runs":[0-9]*' "$work/out.txt" | cut -d: -f2 || true)
+  runs=$(json_field sort_runs "$work/out.txt")
   echo "bench=memory_budget command=build budget=$budget points=$points wall_s=$wall user_s=$user sys_s=$sys peak_rss_mib=$((rss / 1024)) sort_runs=${runs:-0}"
 done

@@ -49,13 +49,8 @@ echo "bench=save_overlap step=input cloud=$(basename "$cloud") copies=$copies po
 
 declare -A walls
 for run in $(seq 1 "$runs"); do
-  # The build and the save back to back, after the dd runs, which of them first alternating:
-  # on a VM that hands freed memory back to its host, a process that starts after a second of
-  # little memory use faults its memory in at several times the cost (README, "the host's slow
-  # phase"), and with the save always after the dd runs it alone paid that.
-  pair="build save"
-  [ $((run % 2)) -eq 0 ] && pair="save build"
-  for step in $disk_steps $pair; do
+  # The save used to come right after the dd runs and alone paid the host's slow phase.
+  for step in $disk_steps $(in_turn "$run" build save); do
     rm -f "$out/out.omh"
     case $step in
       build) read -r wall user sys rss < <(measure "$cli" build "$input") ;;
@@ -70,10 +65,10 @@ for run in $(seq 1 "$runs"); do
     fi
     extra=
     if [ "$step" = save ]; then
-      read_s=$(grep -o '"read_s":[0-9.e+-]*' "$work/out.txt" | cut -d: -f2)
+      read_s=$(json_field read_s "$work/out.txt")
       [ -n "$read_s" ] || { echo "save_overlap: the save printed no read_s" >&2; exit 1; }
       extra=$(awk -v r="$read_s" -v w="$wall" 'BEGIN { printf " read_s=%.3f after_read_s=%.3f", r, w - r }')
-      walls[read]+="$read_s "
+      walls[read_phase]+="$read_s "
     fi
     echo "bench=save_overlap step=$step run=$run points=$points wall_s=$wall user_s=$user sys_s=$sys peak_rss_mib=$((rss / 1024))$extra"
     walls[$step]+="$wall "
@@ -85,8 +80,8 @@ dd=$(echo "${walls[dd]}" | median)
 direct=none
 [ -n "${walls[dd_direct]:-}" ] && direct=$(echo "${walls[dd_direct]}" | median)
 save=$(echo "${walls[save]}" | median)
-read=$(echo "${walls[read]}" | median)
-awk -v p="$points" -v b="$bytes" -v bw="$build" -v dw="$dd" -v xw="$direct" -v sw="$save" -v rs="$read" 'BEGIN {
+read_phase=$(echo "${walls[read_phase]}" | median)
+awk -v p="$points" -v b="$bytes" -v bw="$build" -v dw="$dd" -v xw="$direct" -v sw="$save" -v rs="$read_phase" 'BEGIN {
   disk = (xw != "none" && xw + 0 < dw + 0) ? xw : dw
   longer = (bw > disk) ? bw : disk
   floor = (bw > rs + disk) ? bw : rs + disk
